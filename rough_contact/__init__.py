@@ -1,0 +1,16 @@
+"""rough_contact: 3D frictional contact across rough interfaces for FEniCSx (DOLFINx 0.5.2).
+
+Model: R. Buczkowski and M. Kleiber, "Statistical Models of Rough Surfaces for Finite Element
+3D-Contact Analysis", Arch Comput Methods Eng 16 (2009) 399-424.
+
+Layers (each imports only those above it in this list):
+    surface, asperity, population     pure numpy/scipy rough-surface micro-model
+    interface                         pure numpy interface laws at quadrature points
+    fem, solver                       DOLFINx / PETSc (the only packages importing them)
+
+Internal unit system: mm, N, MPa (N/mm^2), so stiffnesses per area are in MPa/mm = N/mm^3.
+Spectral moments are given in the paper's micrometre convention at the API boundary
+(see rough_contact.surface).
+"""
+
+__version__ = "0.1.0"

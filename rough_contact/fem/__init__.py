@@ -1,0 +1,1 @@
+"""DOLFINx layer: meshes from gmsh, the contact interface operator, bulk problem (imports dolfinx)."""

@@ -1,0 +1,1 @@
+"""Pure-numpy interface laws evaluated at facet quadrature points (no dolfinx import)."""
