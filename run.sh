@@ -49,6 +49,10 @@ export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 # One BLAS thread per MPI rank: the machines have 2 cores.
 export OPENBLAS_NUM_THREADS="${OPENBLAS_NUM_THREADS:-1}" OMP_NUM_THREADS="${OMP_NUM_THREADS:-1}"
 export MPLBACKEND=Agg
+# glibc returns large freed blocks to the OS and page-faults them again on the next call: the
+# vectorised interface kernels allocate multi-MB temporaries per call, so keep them mapped
+# (about 2x on the interface law, benchmarks/bench_interface_law.py).
+export MALLOC_MMAP_THRESHOLD_="${MALLOC_MMAP_THRESHOLD_:-134217728}" MALLOC_TRIM_THRESHOLD_="${MALLOC_TRIM_THRESHOLD_:-536870912}"
 
 # pytest exits 5 when it collects nothing (a directory without tests yet): not a failure.
 run_pytest() {

@@ -1,0 +1,162 @@
+"""Patch-test scenes: two stacked blocks, or one block on a rigid plane. Units: mm.
+
+``two_blocks``: lower block [0, lx] x [0, ly] x [-h1, 0], upper block
+[0, lx] x [0, ly] x [0, h2], in contact at z = 0 on a conforming interface (the upper
+block's nodes on z = 0 are duplicated, see ``rough_contact.fem.mesh``).
+
+Labels (tags in brackets):
+    bodies: "upper" (1), "lower" (2)
+    surfaces: "contact_upper" (11, first contact surface, upper block bottom),
+    "contact_lower" (12, second, lower block top), "top" (13, z = h2),
+    "bottom" (14, z = -h1), "x0" (15), "x1" (16), "y0" (17), "y1" (18); the side groups
+    hold the sides of both blocks.
+
+``block_on_plane``: one block [0, lx] x [0, ly] x [0, h] on the rigid plane z = 0
+(``contact_pair = (contact, None)``, ``rigid_plane = ((0, 0, 0), (0, 0, 1))``).
+Labels: "block" (1), "contact" (11, z = 0), "top" (13), "x0".."y1" (15-18).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from mpi4py import MPI
+
+from rough_contact.fem.mesh import (Scene, add_groups, build_scene, entity_centers,
+                                    set_transfinite_hexahedra, validate_cell_type,
+                                    validate_order, validate_positive)
+
+__all__ = ["two_blocks", "block_on_plane"]
+
+
+def _side_groups(model, lx, ly, tol):
+    tags, c = entity_centers(model, 2)
+    return {"x0": (15, tags[np.abs(c[:, 0]) < tol]),
+            "x1": (16, tags[np.abs(c[:, 0] - lx) < tol]),
+            "y0": (17, tags[np.abs(c[:, 1]) < tol]),
+            "y1": (18, tags[np.abs(c[:, 1] - ly) < tol])}
+
+
+def _mesh(model, mesh_size, order, cell_type):
+    import gmsh
+
+    if cell_type == "hexahedron":
+        # structured: each box edge gets ceil(length / mesh_size) elements
+        set_transfinite_hexahedra(model, mesh_size, mesh_size)
+    else:
+        gmsh.option.setNumber("Mesh.MeshSizeMax", mesh_size)
+        gmsh.option.setNumber("Mesh.MeshSizeMin", 0.1 * mesh_size)
+    model.mesh.generate(3)
+    if order == 2:
+        gmsh.option.setNumber("Mesh.SecondOrderIncomplete", 0)
+        model.mesh.setOrder(2)
+
+
+def two_blocks(lx: float = 1.0, ly: float = 1.0, h1: float = 1.0, h2: float = 1.0,
+               mesh_size: float = 0.25, order: int = 1, cell_type: str = "tetrahedron",
+               comm: MPI.Comm = MPI.COMM_WORLD) -> Scene:
+    """Two stacked boxes touching on z = 0, conforming interface. Collective.
+
+    Args:
+        lx, ly: plan size of both blocks [mm].
+        h1, h2: heights of the lower and upper block [mm].
+        mesh_size: largest tetrahedron edge, or hexahedron edge target [mm].
+        order: 1 or 2 (P1/P2 tetrahedra, Q1/Q2 27-node hexahedra).
+        cell_type: ``"tetrahedron"`` (unstructured) or ``"hexahedron"`` (structured,
+            each box edge split into ``ceil(length / mesh_size)`` elements).
+        comm: communicator of the mesh (gmsh runs on rank 0).
+
+    Returns:
+        The scene; ``contact_pair = (contact_upper, contact_lower)``.
+    """
+    validate_positive(lx=lx, ly=ly, h1=h1, h2=h2, mesh_size=mesh_size)
+    validate_order(order)
+    validate_cell_type(cell_type)
+    tol = 1e-6 * max(lx, ly, h1, h2)
+    def build(model):
+        lower = model.occ.addBox(0, 0, -h1, lx, ly, h1)
+        upper = model.occ.addBox(0, 0, 0, lx, ly, h2)
+        model.occ.fragment([(3, lower)], [(3, upper)])
+        model.occ.synchronize()
+        vols, vc = entity_centers(model, 3)
+        add_groups(model, 3, {"upper": (1, vols[vc[:, 2] > 0]),
+                              "lower": (2, vols[vc[:, 2] < 0])})
+        tags, c = entity_centers(model, 2)
+        z = c[:, 2]
+        add_groups(model, 2, {"contact_upper": (11, tags[np.abs(z) < tol]),
+                              "contact_lower": (12, tags[np.abs(z) < tol]),
+                              "top": (13, tags[np.abs(z - h2) < tol]),
+                              "bottom": (14, tags[np.abs(z + h1) < tol]),
+                              **_side_groups(model, lx, ly, tol)})
+        _mesh(model, mesh_size, order, cell_type)
+
+    return build_scene(
+        comm, "two_blocks", build, split_body="upper",
+        contact_pair=("contact_upper", "contact_lower"),
+        surface_owners={"contact_upper": "upper", "contact_lower": "lower"},
+        dimensions=dict(lx=lx, ly=ly, h1=h1, h2=h2, mesh_size=mesh_size))
+
+
+def block_on_plane(lx: float = 1.0, ly: float = 1.0, h: float = 1.0,
+                   mesh_size: float = 0.25, order: int = 1, cell_type: str = "tetrahedron",
+                   comm: MPI.Comm = MPI.COMM_WORLD) -> Scene:
+    """One box [0, lx] x [0, ly] x [0, h] resting on the rigid plane z = 0. Collective.
+
+    Args:
+        lx, ly, h: block size [mm].
+        mesh_size: largest tetrahedron edge, or hexahedron edge target [mm].
+        order: 1 or 2.
+        cell_type: ``"tetrahedron"`` or ``"hexahedron"`` (structured).
+        comm: communicator of the mesh.
+
+    Returns:
+        The scene; ``contact_pair = (contact, None)``, rigid half-space z <= 0.
+    """
+    validate_positive(lx=lx, ly=ly, h=h, mesh_size=mesh_size)
+    validate_order(order)
+    validate_cell_type(cell_type)
+    tol = 1e-6 * max(lx, ly, h)
+    def build(model):
+        block = model.occ.addBox(0, 0, 0, lx, ly, h)
+        model.occ.synchronize()
+        add_groups(model, 3, {"block": (1, [block])})
+        tags, c = entity_centers(model, 2)
+        add_groups(model, 2, {"contact": (11, tags[np.abs(c[:, 2]) < tol]),
+                              "top": (13, tags[np.abs(c[:, 2] - h) < tol]),
+                              **_side_groups(model, lx, ly, tol)})
+        _mesh(model, mesh_size, order, cell_type)
+
+    return build_scene(
+        comm, "block_on_plane", build, split_body="block", contact_pair=("contact", None),
+        rigid_plane=(np.zeros(3), np.array([0.0, 0.0, 1.0])),
+        dimensions=dict(lx=lx, ly=ly, h=h, mesh_size=mesh_size))
+
+
+def main(argv=None) -> None:
+    """Build the scene, print its labels and measures, optionally write XDMF."""
+    import argparse
+    import logging
+
+    from rough_contact.fem.mesh import describe, write_xdmf
+
+    logging.getLogger().setLevel(logging.WARNING)
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0], allow_abbrev=False)
+    parser.add_argument("--mesh-size", type=float, default=None)
+    parser.add_argument("--lx", type=float, default=None)
+    parser.add_argument("--ly", type=float, default=None)
+    parser.add_argument("--h1", type=float, default=None)
+    parser.add_argument("--h2", type=float, default=None)
+    parser.add_argument("--order", type=int, default=1)
+    parser.add_argument("--cell-type", default=None, choices=["tetrahedron", "hexahedron"])
+    parser.add_argument("--xdmf", default=None, help="write mesh and tags to this file")
+    opts = parser.parse_args(argv)
+    kwargs = {k: v for k, v in vars(opts).items() if k != "xdmf" and v is not None}
+    scene = two_blocks(**kwargs)
+    text = describe(scene)
+    if scene.mesh.comm.rank == 0:
+        print(text)
+    if opts.xdmf:
+        write_xdmf(scene, opts.xdmf)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,781 @@
+"""Slip-hardening friction at interface points: return mapping and consistent tangent.
+
+Units: tractions and pressures in MPa, slips in mm, stiffnesses per area in MPa/mm,
+hardening rates in 1/mm.
+
+Orthotropic model, paper section 8.1
+------------------------------------
+Friction coefficients harden with the accumulated slip along each axis, (89)-(90):
+
+    mu_i = mu_mi [1 - (1 - mu_oi) exp(-n_i kappa_i)],   i = x, y,
+
+slip criterion (91), an ellipse scaled by the contact pressure p = -t_N:
+
+    f = sqrt((t_x/mu_x)^2 + (t_y/mu_y)^2) - p <= 0,
+
+non-associated slip potential (98)/(101) with axes (nu_x, nu_y); only the ratio nu_y/nu_x
+matters (the size is absorbed by the slip multiplier), either fixed or from the k-form of (98),
+nu_y/nu_x = (mu_y/mu_x)^k. The potential's t_N term only produces dilatancy, which the paper
+removes (Delta u^p_N = 0), so (98) and the Huber-von Mises cylinder (101) give the same law here.
+Slip rule (99): Delta s_p = Delta gamma dg/dt_T, dg/dt_i = t_i / (nu_i^2 ||t||_nu).
+
+Isotropic model, paper section 8.2
+----------------------------------
+(119) mu_F = mu_m [1 - (1 - beta) exp(-n kappa)], kappa = effective plastic slip (path length),
+(120) f = ||t_T|| - mu_F p,  (121) circular potential (slip coaxial with the traction).
+
+Decisions (documented in the README):
+    * Elastic part in TOTAL form: t_T = K_T(h) (s - s_p), K_T = diag(kTx, kTy), kT_i = c_i kN(h)
+      (``tangential.TangentialStiffness``). On opening (kN -> 0) the elastic slip is released and
+      the plastic slip s_p is kept. The tangent therefore contains dK_T/dg = c_i dkN/dh.
+    * Hardening variables accumulate slip MAGNITUDE: kappa_i += |Delta s_p,i| (orthotropic) and
+      kappa += ||Delta s_p|| (isotropic), so hardening never reverses on unloading. For monotonic
+      slip along +x this is the paper's u^p_Tx.
+    * With the k-form of the potential, the axis ratio uses the committed (start-of-increment)
+      friction coefficients, so each step solves one scalar equation (exact when mu_o = 1 or
+      n = 0; otherwise lagged by one increment).
+    * Backward Euler (closest-point type) return map. Writing lambda = Delta gamma/||t||_nu and
+      w_i = 1/nu_i^2, the corrected traction is diagonal in lambda,
+          t_i = t_trial,i / (1 + lambda kT_i w_i),
+      so each slipping point solves ONE scalar equation for lambda >= 0 (monotone, unique root),
+      by safeguarded Newton on H(lambda) = p/N(lambda) - 1 (N = ||t||_mu, linear in lambda for
+      isotropic perfect friction, so Newton is exact in one step there).
+    * Isotropic law with kTx == kTy: radial return, tau = p mu_F(kappa_n + (T_trial - tau)/kT),
+      closed form without hardening, else a monotone scalar Newton on tau.
+    * p below 1e-16 of the trial norm (including p = 0 and denormals): closed-form limit (all
+      elastic slip becomes plastic, t = p times the slip direction on the ellipse), no overflow.
+    * After the Newton reaches |H| <= 1e-10 one more Newton step is taken, so the map is smooth
+      to round-off (f = 0 to ~1e-16 p) and finite differences reproduce the tangent.
+    * The tangent returned is the ALGORITHMIC one (derivative of the discrete map), including the
+      coupling to the normal jump through p(h) and kT(h); ``continuum_tangent`` gives the paper's
+      (107)-(110) for comparison.
+
+Sign convention (see common.md): t = dpsi/djump, jump = (g, s_x, s_y), t_N = -p, so the friction
+traction t_T points along the elastic slip s - s_p (it resists the motion of the second body).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Optional, Tuple
+
+import numpy as np
+
+__all__ = [
+    "OrthotropicSlipHardening",
+    "IsotropicSlipHardening",
+    "FrictionResult",
+    "ReturnMappingError",
+    "continuum_tangent",
+    "directional_coefficient",
+    "traction_angle",
+    "limit_coefficient",
+]
+
+_TOL_LOOSE = 1e-10  # |H| = |p/N - 1| (or |R|/(p mu)) before the final polishing Newton step
+_MAX_ITER = 80
+_RELEASE = 1e-16  # p < 1e-16 N_trial min(a)/max(a): closed-form release limit (no overflow)
+
+
+class ReturnMappingError(RuntimeError):
+    """The local Newton of the return map did not converge at some points."""
+
+
+@dataclass(frozen=True)
+class FrictionResult:
+    """Outcome of a return map at m contact points.
+
+    Attributes:
+        traction: (m, 2) tangential traction (t_x, t_y) [MPa].
+        tangent: (m, 2, 3) d t_T / d(g, s_x, s_y) [MPa/mm] (algorithmic).
+        plastic_increment: (m, 2) Delta s_p [mm].
+        slipping: (m,) bool, the friction limit is active.
+        iterations: number of local Newton iterations used (0 if nothing slipped).
+    """
+
+    traction: np.ndarray
+    tangent: np.ndarray
+    plastic_increment: np.ndarray
+    slipping: np.ndarray
+    iterations: int = 0
+
+
+@dataclass
+class _Columns:
+    """Per-point inputs of the return map as 1-D columns (internal; no validation).
+
+    ex, ey: elastic trial slip s - s_p [mm]; kx, ky: kT [MPa/mm]; dkx, dky: dkT/dg [MPa/mm^2];
+    p: pressure [MPa]; kn: -dp/dg [MPa/mm]; kapx, kapy: accumulated |slip| [mm];
+    path: effective plastic slip [mm].
+    """
+
+    ex: np.ndarray
+    ey: np.ndarray
+    kx: np.ndarray
+    ky: np.ndarray
+    dkx: np.ndarray
+    dky: np.ndarray
+    p: np.ndarray
+    kn: np.ndarray
+    kapx: np.ndarray
+    kapy: np.ndarray
+    path: np.ndarray
+
+    def take(self, idx) -> _Columns:
+        return _Columns(*(getattr(self, f).take(idx) for f in self.__dataclass_fields__))
+
+
+@dataclass
+class _Slip:
+    """Return-map output at the slipping points idx (internal)."""
+
+    idx: np.ndarray
+    dspx: np.ndarray
+    dspy: np.ndarray
+    iterations: int
+
+
+# ----------------------------------------------------------------------------- validation
+def _pair(name: str, value, lo: float, hi: float, lo_open: bool, hi_open: bool = True):
+    arr = np.asarray(value, dtype=float)
+    if arr.ndim == 0:
+        arr = np.array([arr, arr], dtype=float)
+    if arr.shape != (2,):
+        raise ValueError(f"{name} must be a scalar or a pair (x, y), got {value!r}")
+    for axis, v in zip("xy", arr):
+        ok = (np.isfinite(v) and (v > lo if lo_open else v >= lo)
+              and (v < hi if hi_open else v <= hi))
+        if not ok:
+            lb = "(" if lo_open else "["
+            rb = ")" if hi_open else "]"
+            raise ValueError(f"{name}[{axis}] = {v!r} must lie in {lb}{lo}, {hi}{rb}")
+    return float(arr[0]), float(arr[1])
+
+
+def _scalar(name: str, value, lo: float, hi: float, lo_open: bool, hi_open: bool = True) -> float:
+    v = float(value)
+    ok = np.isfinite(v) and (v > lo if lo_open else v >= lo) and (v < hi if hi_open else v <= hi)
+    if not ok:
+        lb = "(" if lo_open else "["
+        rb = ")" if hi_open else "]"
+        raise ValueError(f"{name} = {value!r} must lie in {lb}{lo}, {hi}{rb}")
+    return v
+
+
+def _columns(elastic_slip, kt, dkt, pressure, kn, accumulated_slip, slip_path) -> _Columns:
+    e = np.asarray(elastic_slip, dtype=float)
+    if e.ndim != 2 or e.shape[1] != 2:
+        raise ValueError(f"elastic_slip must have shape (m, 2), got {e.shape}")
+    m = e.shape[0]
+    arrs = {}
+    for name, arr, shape in (("kt", kt, (m, 2)), ("dkt", dkt, (m, 2)), ("pressure", pressure, (m,)),
+                             ("kn", kn, (m,)), ("accumulated_slip", accumulated_slip, (m, 2)),
+                             ("slip_path", slip_path, (m,))):
+        a = np.asarray(arr, dtype=float)
+        if a.shape != shape:
+            raise ValueError(f"{name} must have shape {shape}, got {a.shape}")
+        arrs[name] = a
+    for name in arrs:
+        if not np.isfinite(arrs[name]).all():
+            raise ValueError(f"{name} must be finite at every point")
+    if not np.isfinite(e).all():
+        raise ValueError("elastic_slip must be finite at every point")
+    if np.any(arrs["pressure"] < 0):
+        raise ValueError("pressure must be >= 0 at every point [MPa]")
+    if np.any(arrs["kt"] <= 0):
+        raise ValueError("kt (tangential stiffness) must be > 0 at every contact point [MPa/mm]")
+    if np.any(arrs["kn"] < 0):
+        raise ValueError("kn (normal stiffness) must be >= 0 at every point [MPa/mm]")
+    kt, dkt, kap = arrs["kt"], arrs["dkt"], arrs["accumulated_slip"]
+    return _Columns(e[:, 0].copy(), e[:, 1].copy(), kt[:, 0].copy(), kt[:, 1].copy(),
+                    dkt[:, 0].copy(), dkt[:, 1].copy(), arrs["pressure"], arrs["kn"],
+                    kap[:, 0].copy(), kap[:, 1].copy(), arrs["slip_path"])
+
+
+def _public_result(law, c: _Columns) -> FrictionResult:
+    m = c.ex.shape[0]
+    traction = np.empty((m, 2))
+    tangent = np.empty((m, 2, 3))
+    slip = law._map(c, traction, tangent)
+    dsp = np.zeros((m, 2))
+    slipping = np.zeros(m, dtype=bool)
+    if slip is not None:
+        dsp[slip.idx, 0] = slip.dspx
+        dsp[slip.idx, 1] = slip.dspy
+        slipping[slip.idx] = True
+    return FrictionResult(traction, tangent, dsp, slipping, 0 if slip is None else slip.iterations)
+
+
+def _norm(x, y):
+    """sqrt(x^2 + y^2) of arrays; np.hypot (30x slower) only where squares could over/underflow."""
+    r = np.sqrt(x * x + y * y)
+    bad = ~((r < 1e150) & (r > 1e-150))
+    if bad.any():
+        r[bad] = np.hypot(x[bad], y[bad])
+    return r
+
+
+# ----------------------------------------------------------------------------- hardening
+def _hardening(mu_m: float, mu_o: float, n: float, kappa):
+    """mu(kappa) and dmu/dkappa of (89)/(90)/(119); kappa >= 0 [mm].
+
+    n = 0 keeps the initial value mu_o mu_m; mu_o = 1 gives the constant mu_m. Constant laws
+    return Python floats (broadcast for free).
+    """
+    if n == 0.0 or mu_o == 1.0:
+        return (mu_m * mu_o if n == 0.0 else mu_m), 0.0
+    soft = np.exp(-n * kappa)
+    soft *= 1.0 - mu_o
+    return mu_m * (1.0 - soft), (mu_m * n) * soft
+
+
+# ----------------------------------------------------------------------------- Newton driver
+def _solve_lambda(model, lam0, lo, hi, what: str):
+    """Safeguarded Newton for H(lambda) = 0 on all points at once (H increasing, H(lo)<0<=H(hi)).
+
+    ``model(lam) -> (H, dH)``. Iterates until |H| <= 1e-10 everywhere, then takes one more
+    Newton step: with quadratic convergence that leaves lambda at round-off, so the result is a
+    smooth function of the inputs to ~1e-16 (finite differences of the traction see the
+    tangent, not the solver tolerance). Returns (lam, iterations).
+    """
+    lam = lam0
+    for it in range(1, _MAX_ITER + 1):
+        H, dH = model(lam)
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            step = lam - H / dH
+        aH = np.abs(H)
+        if aH.max() <= _TOL_LOOSE:
+            ok = np.isfinite(step) & (step >= 0.0)
+            return (step if ok.all() else np.where(ok, step, lam)), it
+        below = H < 0.0
+        lo = np.where(below, lam, lo)
+        hi = np.where(below, hi, lam)
+        ok = (step > lo) & (step < hi)
+        if ok.all():
+            lam = step
+            continue
+        with np.errstate(invalid="ignore", over="ignore"):
+            geometric = (lo > 0.0) & (hi > 16.0 * lo)
+            mid = np.where(geometric, np.sqrt(lo * hi), 0.5 * (lo + hi))
+        new = np.where(ok, step, mid)
+        done = (aH <= _TOL_LOOSE) | ((hi - lo) <= 4e-16 * hi)
+        lam = np.where(done, lam, new)
+        if done.all():
+            return lam, it
+    nbad = int(np.count_nonzero(aH > _TOL_LOOSE))
+    raise ReturnMappingError(
+        f"{what}: local Newton did not converge at {nbad} of {lam.size} slipping points after "
+        f"{_MAX_ITER} iterations (max |p/N - 1| = {aH.max():.3e}; non-finite input or extreme "
+        "parameters)"
+    )
+
+
+def _initial_bracket(excess_num, p, ax, ay, qx2, qy2, n_lo):
+    """Bracket and first guess for lambda: N(lam) is squeezed by 1/(1 + lam a) bounds."""
+    with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
+        excess = np.minimum(excess_num / p, 1e300) - 1.0
+        amin = np.minimum(ax, ay)
+        amax = np.maximum(ax, ay)
+        hi = np.minimum(excess / amin, 1e300)
+        lo = np.maximum((np.minimum(n_lo / p, 1e300) - 1.0) / amax, 0.0)
+        aeff = (qx2 * ax + qy2 * ay) / (qx2 + qy2)
+        lam0 = np.clip(excess / aeff, lo, hi)
+    return lam0, lo, hi
+
+
+def _write_stick(c: _Columns, out_t, out_D):
+    """Elastic (stick) values at every point: t = K_T e, dt/d(g, s) = [dK_T e, K_T]."""
+    tx = c.kx * c.ex
+    ty = c.ky * c.ey
+    out_t[:, 0] = tx
+    out_t[:, 1] = ty
+    out_D[:, 0, 0] = c.dkx * c.ex
+    out_D[:, 0, 1] = c.kx
+    out_D[:, 0, 2] = 0.0
+    out_D[:, 1, 0] = c.dky * c.ey
+    out_D[:, 1, 1] = 0.0
+    out_D[:, 1, 2] = c.ky
+    return tx, ty
+
+
+def _write_slip(idx, out_t, out_D, tx, ty, D):
+    out_t[idx, 0] = tx
+    out_t[idx, 1] = ty
+    for (i, j), v in D.items():
+        out_D[idx, i, j] = v
+
+
+def _tangent(c: _Columns, tx, ty, lam, wx, wy, Dx, Dy, bx, by, c0):
+    """Algorithmic tangent rows d t_T / d(g, s_x, s_y) at slipping points.
+
+    t_i = t_trial,i / D_i with D_i = 1 + lam kT_i w_i and the scalar equation F = N - p = 0;
+    dt_i = r_i - v_i dlam,  r_i = [dt_trial,i - t_i w_i lam dkT_i]/D_i,  v_i = t_i w_i kT_i/D_i,
+    dlam = (sum_i b_i r_i - dp)/den,  den = sum_i b_i v_i - c0 = -dN/dlam > 0,  dp/dg = -kN.
+    """
+    rsx = c.kx / Dx
+    rsy = c.ky / Dy
+    lwx = lam * wx
+    lwy = lam * wy
+    rgx = c.dkx * (c.ex - lwx * tx) / Dx
+    rgy = c.dky * (c.ey - lwy * ty) / Dy
+    vx = tx * wx * rsx  # = t_x w_x kTx / D_x
+    vy = ty * wy * rsy
+    inv = 1.0 / (bx * vx + by * vy - c0)
+    dl_g = (bx * rgx + by * rgy + c.kn) * inv
+    dl_sx = bx * rsx * inv
+    dl_sy = by * rsy * inv
+    return {(0, 0): rgx - vx * dl_g, (0, 1): rsx - vx * dl_sx, (0, 2): -vx * dl_sy,
+            (1, 0): rgy - vy * dl_g, (1, 1): -vy * dl_sx, (1, 2): rsy - vy * dl_sy}
+
+
+def _spread(ax, ay):
+    """min(a)/max(a): the release limit needs lam a_i >> 1 along BOTH axes."""
+    return np.minimum(ax, ay) / np.maximum(ax, ay)
+
+
+def _released(c: _Columns, ux, uy, mux, muy):
+    """Limit p << |t_trial| (p/N_trial < 1e-16 min(a)/max(a)): all elastic slip turns plastic.
+
+    The exact map gives t = t_trial/(1 + lam a) with lam a_i ~ N_trial/p; to double precision
+    t = p u/||u/mu|| with u the slip direction of the potential, Delta s_p = e - t/kT, and the
+    only surviving tangent term is through p: dt/dg = -kN u/||u/mu|| (the others are O(p/N)).
+    The closed form avoids overflow at denormal pressures.
+    """
+    with np.errstate(invalid="ignore", divide="ignore"):
+        nrm = np.hypot(ux / mux, uy / muy)
+        pos = nrm > 0
+        dx = np.where(pos, ux / nrm, 0.0)
+        dy = np.where(pos, uy / nrm, 0.0)
+    tx = c.p * dx
+    ty = c.p * dy
+    D = {(0, 0): -c.kn * dx, (0, 1): 0.0, (0, 2): 0.0, (1, 0): -c.kn * dy, (1, 1): 0.0,
+         (1, 2): 0.0}
+    return tx, ty, c.ex - tx / c.kx, c.ey - ty / c.ky, D
+
+
+# ----------------------------------------------------------------------------- orthotropic
+@dataclass(frozen=True)
+class OrthotropicSlipHardening:
+    """Orthotropic slip-hardening friction, eqs (89)-(118).
+
+    Args:
+        mu_macro: (mu_mx, mu_my), macroscopic (saturated) friction coefficients, > 0 [-].
+        mu_initial_ratio: (mu_ox, mu_oy), initial coefficient as a fraction of mu_macro, in
+            (0, 1] [-] (1 = no hardening).
+        hardening: (n_x, n_y), slip-hardening rates, >= 0 [1/mm] (0 = constant mu = mu_o mu_m).
+        potential_axes: (nu_x, nu_y) of the slip potential (98)/(101), > 0 [-]; only the ratio
+            matters. None (and no exponent) means a circle: slip coaxial with the traction.
+        potential_exponent: k of (98), nu_y/nu_x = (mu_y/mu_x)^k (k = 1 associated, k = 0
+            circle); evaluated with the committed coefficients. Exclusive with potential_axes.
+
+    A scalar given for a pair applies to both axes.
+    """
+
+    mu_macro: Tuple[float, float]
+    mu_initial_ratio: Tuple[float, float] = (1.0, 1.0)
+    hardening: Tuple[float, float] = (0.0, 0.0)
+    potential_axes: Optional[Tuple[float, float]] = None
+    potential_exponent: Optional[float] = None
+
+    def __post_init__(self) -> None:
+        s = object.__setattr__
+        s(self, "mu_macro", _pair("mu_macro", self.mu_macro, 0.0, np.inf, True))
+        s(self, "mu_initial_ratio",
+          _pair("mu_initial_ratio", self.mu_initial_ratio, 0.0, 1.0, True, hi_open=False))
+        s(self, "hardening", _pair("hardening", self.hardening, 0.0, np.inf, False))
+        if self.potential_axes is not None and self.potential_exponent is not None:
+            raise ValueError("give either potential_axes or potential_exponent, not both")
+        if self.potential_axes is not None:
+            s(self, "potential_axes",
+              _pair("potential_axes", self.potential_axes, 0.0, np.inf, True))
+        if self.potential_exponent is not None:
+            s(self, "potential_exponent",
+              _scalar("potential_exponent", self.potential_exponent, -np.inf, np.inf, True))
+
+    # -- coefficients ---------------------------------------------------------------------
+    def _mu(self, kapx, kapy):
+        mux, dmux = _hardening(self.mu_macro[0], self.mu_initial_ratio[0], self.hardening[0], kapx)
+        muy, dmuy = _hardening(self.mu_macro[1], self.mu_initial_ratio[1], self.hardening[1], kapy)
+        return mux, dmux, muy, dmuy
+
+    def coefficients(self, accumulated_slip: np.ndarray):
+        """Friction coefficients and slopes at accumulated slip kappa (m, 2) [mm].
+
+        Returns:
+            mu (m, 2) [-] and dmu/dkappa (m, 2) [1/mm], eqs (89)-(90), (111)-(112).
+        """
+        k = np.asarray(accumulated_slip, dtype=float)
+        mux, dmux, muy, dmuy = self._mu(k[..., 0], k[..., 1])
+        b = np.broadcast_arrays(mux, dmux, muy, dmuy, k[..., 0])
+        return np.stack([b[0], b[2]], axis=-1), np.stack([b[1], b[3]], axis=-1)
+
+    def _weights(self, mux, muy):
+        """(w_x, w_y) = (1, (nu_x/nu_y)^2) of the slip potential, floats or arrays [-]."""
+        if self.potential_exponent is not None:
+            return 1.0, (mux / muy) ** (2.0 * self.potential_exponent)
+        if self.potential_axes is not None:
+            return 1.0, (self.potential_axes[0] / self.potential_axes[1]) ** 2
+        return 1.0, 1.0
+
+    def slip_function(self, traction_t, pressure, accumulated_slip):
+        """f of (91) [MPa] at traction (m, 2), pressure (m,), accumulated slip (m, 2)."""
+        mu, _ = self.coefficients(accumulated_slip)
+        t = np.asarray(traction_t, dtype=float)
+        return np.hypot(t[:, 0] / mu[:, 0], t[:, 1] / mu[:, 1]) - np.asarray(pressure, dtype=float)
+
+    # -- return map ---------------------------------------------------------------------
+    def return_map(self, elastic_slip, kt, dkt, pressure, kn, accumulated_slip, slip_path):
+        """Backward-Euler return map at m contact points (all arrays batch-first).
+
+        Args:
+            elastic_slip: (m, 2) trial elastic slip s - s_p(committed) [mm].
+            kt: (m, 2) tangential stiffnesses (kTx, kTy) > 0 [MPa/mm].
+            dkt: (m, 2) their derivatives d kT / d g [MPa/mm^2].
+            pressure: (m,) contact pressure p >= 0 [MPa].
+            kn: (m,) normal stiffness -dp/dg >= 0 [MPa/mm].
+            accumulated_slip: (m, 2) committed hardening variables kappa_x, kappa_y [mm].
+            slip_path: (m,) committed effective plastic slip (unused by this law) [mm].
+
+        Returns:
+            FrictionResult (traction, tangent (m, 2, 3) wrt (g, s_x, s_y), Delta s_p, slipping).
+
+        Raises:
+            ValueError: wrong shapes or non-physical inputs. ReturnMappingError: no convergence.
+        """
+        return _public_result(self, _columns(elastic_slip, kt, dkt, pressure, kn,
+                                             accumulated_slip, slip_path))
+
+    def _map(self, c: _Columns, out_t, out_D) -> Optional[_Slip]:
+        """Write traction/tangent into out_t (m, 2), out_D (m, 2, 3) views; return slip data."""
+        mux, _, muy, _ = self._mu(c.kapx, c.kapy)
+        tx, ty = _write_stick(c, out_t, out_D)
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            qx = tx / (mux * c.p)
+            qy = ty / (muy * c.p)
+            slipping = qx * qx + qy * qy > 1.0
+        if not slipping.any():
+            return None
+        idx = np.flatnonzero(slipping)
+        s = c.take(idx)
+        mux_s = mux if np.isscalar(mux) else mux.take(idx)
+        muy_s = muy if np.isscalar(muy) else muy.take(idx)
+        wx, wy = self._weights(mux_s, muy_s)
+        cx, cy = tx.take(idx), ty.take(idx)
+        ax = s.kx * wx
+        ay = s.ky * wy
+        ntr = _norm(cx / mux_s, cy / muy_s)
+        released = ntr * (_RELEASE * _spread(ax, ay)) > s.p
+        dspx = np.empty(idx.size)
+        dspy = np.empty(idx.size)
+        its = 0
+        if released.any():
+            r = np.flatnonzero(released)
+            sr = s.take(r)
+            wyr = wy if np.isscalar(wy) else wy.take(r)
+            ux, uy = sr.ex / wx, sr.ey / wyr
+            mx, _, my, _ = self._mu(sr.kapx + np.abs(sr.ex), sr.kapy + np.abs(sr.ey))
+            rtx, rty, dspx[r], dspy[r], D = _released(sr, ux, uy, mx, my)
+            _write_slip(idx[r], out_t, out_D, rtx, rty, D)
+        if not released.all():
+            g = np.flatnonzero(~released)
+            if released.any():
+                sg = s.take(g)
+                pick = lambda v: v if np.isscalar(v) else v.take(g)  # noqa: E731
+                res = self._slip(sg, pick(mux_s), pick(muy_s), pick(wy), cx.take(g), cy.take(g),
+                                 pick(ntr), ax.take(g), pick(ay))
+            else:
+                g = slice(None)
+                res = self._slip(s, mux_s, muy_s, wy, cx, cy, ntr, ax, ay)
+            gtx, gty, dspx[g], dspy[g], D, its = res
+            _write_slip(idx[g], out_t, out_D, gtx, gty, D)
+        return _Slip(idx, dspx, dspy, its)
+
+    def _slip(self, s: _Columns, mux_n, muy_n, wy, cx, cy, ntr, ax, ay):
+        mmx, mmy = self.mu_macro
+        wx = 1.0
+        acx, acy = np.abs(cx), np.abs(cy)
+        qx2 = (cx / mux_n) ** 2
+        qy2 = (cy / muy_n) ** 2
+        n_lo = _norm(cx / mmx, cy / mmy)  # trial norm with saturated mu (lower bound of N)
+        lam0, lo, hi = _initial_bracket(ntr, s.p, ax, ay, qx2, qy2, n_lo)
+        p = s.p
+
+        def state(lam):
+            Dx = 1.0 + lam * ax
+            Dy = 1.0 + lam * ay
+            tx = cx / Dx
+            ty = cy / Dy
+            mux, dmux, muy, dmuy = self._mu(s.kapx + lam * wx * acx / Dx,
+                                            s.kapy + lam * wy * acy / Dy)
+            return Dx, Dy, tx, ty, mux, dmux, muy, dmuy
+
+        def model(lam):
+            Dx, Dy, tx, ty, mux, dmux, muy, dmuy = state(lam)
+            qx = tx / mux
+            qy = ty / muy
+            N2 = qx * qx + qy * qy
+            # d/dlam: dt_i = -a_i t_i / D_i, dkappa_i = w_i |t_i| / D_i
+            dqx = (-ax * tx - qx * dmux * wx * np.abs(tx)) / (Dx * mux)
+            dqy = (-ay * ty - qy * dmuy * wy * np.abs(ty)) / (Dy * muy)
+            N = np.sqrt(N2)
+            # H = p/N - 1, dH = -p dN/N^2 with dN = (q . dq)/N
+            return p / N - 1.0, -p * (qx * dqx + qy * dqy) / (N2 * N)
+
+        lam, its = _solve_lambda(model, lam0, lo, hi, "orthotropic friction return map")
+        Dx, Dy, tx, ty, mux, dmux, muy, dmuy = state(lam)
+        # linearisation of F = N(t, mu(kappa)) - p
+        qx = tx / mux
+        qy = ty / muy
+        N = _norm(qx, qy)
+        ntx = qx / (N * mux)
+        nty = qy / (N * muy)
+        nmx = -qx * ntx
+        nmy = -qy * nty
+        bx = ntx + nmx * dmux * lam * wx * np.sign(tx)
+        by = nty + nmy * dmuy * lam * wy * np.sign(ty)
+        c0 = nmx * dmux * wx * np.abs(tx) + nmy * dmuy * wy * np.abs(ty)
+        D = _tangent(s, tx, ty, lam, wx, wy, Dx, Dy, bx, by, c0)
+        return tx, ty, lam * wx * tx, lam * wy * ty, D, its
+
+
+# ----------------------------------------------------------------------------- isotropic
+@dataclass(frozen=True)
+class IsotropicSlipHardening:
+    """Isotropic slip-hardening friction (Fredriksson), eqs (119)-(131).
+
+    Args:
+        mu_macro: macroscopic friction coefficient mu_m > 0 [-].
+        mu_initial_ratio: beta of (119), initial coefficient as a fraction of mu_m, in (0, 1] [-].
+        hardening: slip-hardening rate n >= 0 [1/mm].
+
+    The hardening variable is the effective plastic slip (path length sum ||Delta s_p||).
+    With kTx == kTy the return map is radial and is solved in closed form (no hardening) or by a
+    scalar monotone Newton on the traction magnitude; with kTx != kTy the general scalar return
+    map (as in the orthotropic law) is used.
+    """
+
+    mu_macro: float
+    mu_initial_ratio: float = 1.0
+    hardening: float = 0.0
+
+    def __post_init__(self) -> None:
+        s = object.__setattr__
+        s(self, "mu_macro", _scalar("mu_macro", self.mu_macro, 0.0, np.inf, True))
+        s(self, "mu_initial_ratio",
+          _scalar("mu_initial_ratio", self.mu_initial_ratio, 0.0, 1.0, True, hi_open=False))
+        s(self, "hardening", _scalar("hardening", self.hardening, 0.0, np.inf, False))
+
+    def _mu(self, kap):
+        return _hardening(self.mu_macro, self.mu_initial_ratio, self.hardening, kap)
+
+    def coefficient(self, slip_path):
+        """mu_F (119) and d mu_F / d kappa (129) at effective plastic slip kappa [mm], arrays."""
+        kap = np.asarray(slip_path, dtype=float)
+        mu, dmu = self._mu(kap)
+        return np.broadcast_to(mu, kap.shape).copy(), np.broadcast_to(dmu, kap.shape).copy()
+
+    def slip_function(self, traction_t, pressure, slip_path):
+        """f of (120) [MPa]."""
+        mu, _ = self.coefficient(slip_path)
+        t = np.asarray(traction_t, dtype=float)
+        return np.hypot(t[:, 0], t[:, 1]) - mu * np.asarray(pressure, dtype=float)
+
+    def return_map(self, elastic_slip, kt, dkt, pressure, kn, accumulated_slip, slip_path):
+        """Backward-Euler return map; arguments and result as ``OrthotropicSlipHardening``.
+
+        ``accumulated_slip`` is unused; ``slip_path`` (m,) is the hardening variable [mm].
+        """
+        return _public_result(self, _columns(elastic_slip, kt, dkt, pressure, kn,
+                                             accumulated_slip, slip_path))
+
+    def _map(self, c: _Columns, out_t, out_D) -> Optional[_Slip]:
+        mu, _ = self._mu(c.path)
+        tx, ty = _write_stick(c, out_t, out_D)
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            lim = mu * c.p
+            qx = tx / lim
+            qy = ty / lim
+            slipping = qx * qx + qy * qy > 1.0
+        if not slipping.any():
+            return None
+        idx = np.flatnonzero(slipping)
+        s = c.take(idx)
+        mu_s = mu if np.isscalar(mu) else mu.take(idx)
+        cx, cy = tx.take(idx), ty.take(idx)
+        T = _norm(cx, cy)
+        released = T * (_RELEASE * _spread(s.kx, s.ky)) > mu_s * s.p
+        dspx = np.empty(idx.size)
+        dspy = np.empty(idx.size)
+        its = 0
+        if released.any():
+            r = np.flatnonzero(released)
+            sr = s.take(r)
+            mr, _ = self._mu(sr.path + np.hypot(sr.ex, sr.ey))
+            rtx, rty, dspx[r], dspy[r], D = _released(sr, sr.ex, sr.ey, mr, mr)
+            _write_slip(idx[r], out_t, out_D, rtx, rty, D)
+        if not released.all():
+            g = np.flatnonzero(~released) if released.any() else slice(None)
+            sg = s.take(g) if released.any() else s
+            pick = (lambda v: v if np.isscalar(v) else v[g])  # noqa: E731
+            args = (sg, pick(mu_s), cx[g], cy[g], T[g])
+            radial = np.array_equal(sg.kx, sg.ky) and np.array_equal(sg.dkx, sg.dky)
+            gtx, gty, dspx[g], dspy[g], D, its = (self._radial(*args) if radial
+                                                  else self._general(*args))
+            _write_slip(idx[g], out_t, out_D, gtx, gty, D)
+        return _Slip(idx, dspx, dspy, its)
+
+    def _radial(self, s: _Columns, mu_n, cx, cy, T):
+        """kTx == kTy: t = tau m, m = t_trial/|t_trial|, tau = p mu(kappa_n + (T - tau)/k)."""
+        k, dk, p, kap = s.kx, s.dkx, s.p, s.path
+        its = 1
+        if self.mu_initial_ratio == 1.0 or self.hardening == 0.0:
+            mu, dmu = mu_n, 0.0
+            tau = p * mu  # closed form
+        else:
+            # R(tau) = tau - p mu(kappa_n + (T - tau)/k) is convex and increasing: Newton from
+            # the right end tau = T (R > 0 there) converges monotonically; one polishing step.
+            tau = T
+            for its in range(1, _MAX_ITER + 1):
+                mu, dmu = self._mu(kap + (T - tau) / k)
+                R = tau - p * mu
+                tau_new = tau - R / (1.0 + p * dmu / k)
+                if np.all(R <= _TOL_LOOSE * p * mu):
+                    tau = tau_new
+                    break
+                tau = tau_new
+            else:
+                raise ReturnMappingError(
+                    f"isotropic friction return map: local Newton did not converge at "
+                    f"{int(np.count_nonzero(R > _TOL_LOOSE * p * mu))} of {tau.size} slipping "
+                    "points")
+            mu, dmu = self._mu(kap + (T - tau) / k)
+        mx = cx / T
+        my = cy / T
+        dgam = (T - tau) / k
+        # d tau = [mu dp + c dT - c dgam dk] / (1 + c),  c = p mu'/k,  dp/dg = -kN
+        # d t_trial = k ds + dk e dg;  dT = m . d t_trial;  dm = (I - m m) d t_trial / T
+        cc = p * dmu / k
+        inv = 1.0 / (1.0 + cc)
+        dT_g = dk * (mx * s.ex + my * s.ey)
+        dtau_g = (cc * (dT_g - dgam * dk) - mu * s.kn) * inv
+        ck = cc * k * inv
+        r = tau / T
+        rk = r * k
+        px = dk * s.ex - mx * dT_g
+        py = dk * s.ey - my * dT_g
+        mxy = mx * my
+        D = {(0, 0): dtau_g * mx + r * px, (1, 0): dtau_g * my + r * py,
+             (0, 1): ck * mx * mx + rk * (1.0 - mx * mx), (0, 2): (ck - rk) * mxy,
+             (1, 1): (ck - rk) * mxy, (1, 2): ck * my * my + rk * (1.0 - my * my)}
+        return tau * mx, tau * my, dgam * mx, dgam * my, D, its
+
+    def _general(self, s: _Columns, mu_n, cx, cy, T):
+        """kTx != kTy: t_i = t_trial,i / (1 + lam kT_i), kappa = kappa_n + lam ||t||."""
+        ax, ay, p, kap = s.kx, s.ky, s.p, s.path
+        lam0, lo, hi = _initial_bracket(T / mu_n, p, ax, ay, cx * cx, cy * cy,
+                                        T / self.mu_macro)
+
+        def state(lam):
+            Dx = 1.0 + lam * ax
+            Dy = 1.0 + lam * ay
+            tx = cx / Dx
+            ty = cy / Dy
+            Tn = _norm(tx, ty)
+            mu, dmu = self._mu(kap + lam * Tn)
+            return Dx, Dy, tx, ty, Tn, mu, dmu
+
+        def model(lam):
+            Dx, Dy, tx, ty, Tn, mu, dmu = state(lam)
+            dT = -(tx * tx * ax / Dx + ty * ty * ay / Dy) / Tn
+            N = Tn / mu
+            dN = dT / mu - Tn * dmu * (Tn + lam * dT) / (mu * mu)
+            return p / N - 1.0, -p * dN / (N * N)
+
+        lam, its = _solve_lambda(model, lam0, lo, hi, "isotropic friction return map")
+        Dx, Dy, tx, ty, Tn, mu, dmu = state(lam)
+        fac = 1.0 / Tn - lam * dmu / mu
+        bx = tx / mu * fac
+        by = ty / mu * fac
+        c0 = -Tn * Tn * dmu / (mu * mu)
+        D = _tangent(s, tx, ty, lam, 1.0, 1.0, Dx, Dy, bx, by, c0)
+        return tx, ty, lam * tx, lam * ty, D, its
+
+
+# ----------------------------------------------------------------------------- paper's formulas
+def continuum_tangent(traction_t, pressure, kn, kt, mu, dmu, potential_axes=(1.0, 1.0)):
+    """The paper's continuum elasto-plastic tangent (105)-(110), in this package's convention.
+
+    The paper writes (107) for (t_x, t_y, t_N = p) against (u_x, u_y, u_N = approach) with
+    constant stiffnesses; here it is returned as d(t_N = -p, t_x, t_y)/d(g, s_x, s_y), with
+    g = -u_N. The hardening modulus uses |dg/dt_i| (hardening by slip magnitude).
+
+    Args:
+        traction_t: (m, 2) tangential traction on the slip surface [MPa].
+        pressure: (m,) contact pressure [MPa] (unused by (107) except through f = 0).
+        kn: (m,) normal stiffness [MPa/mm].
+        kt: (m, 2) tangential stiffnesses [MPa/mm].
+        mu: (m, 2) current (mu_x, mu_y) [-]; dmu: (m, 2) d mu_i / d kappa_i [1/mm].
+        potential_axes: (nu_x, nu_y) [-].
+
+    Returns:
+        (m, 3, 3) tangent [MPa/mm].
+    """
+    t = np.asarray(traction_t, dtype=float)
+    tx, ty = t[:, 0], t[:, 1]
+    mux, muy = mu[:, 0], mu[:, 1]
+    nux, nuy = potential_axes
+    fmu = np.hypot(tx / mux, ty / muy)
+    fnu = np.hypot(tx / nux, ty / nuy)
+    cx = tx / (mux**2 * fmu)
+    cy = ty / (muy**2 * fmu)
+    cz = -1.0
+    dx = tx / (nux**2 * fnu)
+    dy = ty / (nuy**2 * fnu)
+    dz = 0.0
+    ktx, kty = kt[:, 0], kt[:, 1]
+    A = ktx * cx * dx + kty * cy * dy + kn * cz * dz  # (108)
+    H = -(tx**2 * dmu[:, 0] * np.abs(dx) / (mux**3 * fmu)
+          + ty**2 * dmu[:, 1] * np.abs(dy) / (muy**3 * fmu))  # (110)
+    s = 1.0 / (A - H)
+    # (107), rows/cols ordered (x, y, N) in the paper's variables
+    P = np.empty((t.shape[0], 3, 3))
+    P[:, 0, 0] = ktx * (kn * cz * dz + kty * cy * dy - H)
+    P[:, 0, 1] = -ktx * kty * cy * dx
+    P[:, 0, 2] = -ktx * kn * cz * dx
+    P[:, 1, 0] = -ktx * kty * cx * dy
+    P[:, 1, 1] = kty * (ktx * cx * dx + kn * cz * dz - H)
+    P[:, 1, 2] = -kty * kn * cz * dy
+    P[:, 2, 0] = -ktx * kn * cx * dz
+    P[:, 2, 1] = -kty * kn * cy * dz
+    P[:, 2, 2] = kn * (ktx * cx * dx + kty * cy * dy - H)
+    P *= s[:, None, None]
+    D = np.empty_like(P)
+    D[:, 0, 0] = P[:, 2, 2]
+    D[:, 0, 1:] = -P[:, 2, :2]
+    D[:, 1:, 0] = -P[:, :2, 2]
+    D[:, 1:, 1:] = P[:, :2, :2]
+    return D
+
+
+def directional_coefficient(mu_x, mu_y, alpha):
+    """Directional friction coefficient mu_alpha of (115) for slip inclination alpha [rad].
+
+    (115) is the traction magnitude / p for slip at angle alpha under the ASSOCIATED rule
+    (nu ~ mu); for a general potential use ``limit_coefficient(mu_x, mu_y, traction_angle(...))``.
+    """
+    c2 = np.cos(alpha) ** 2
+    s2 = np.sin(alpha) ** 2
+    return np.sqrt((mu_x**4 * c2 + mu_y**4 * s2) / (mu_x**2 * c2 + mu_y**2 * s2))
+
+
+def traction_angle(alpha, nu_x, nu_y):
+    """Traction inclination beta from slip inclination alpha, (118): tan b = tan a (nu_y/nu_x)^2.
+
+    Quadrant-correct (atan2); angles in rad.
+    """
+    return np.arctan2(np.sin(alpha) * nu_y**2, np.cos(alpha) * nu_x**2)
+
+
+def limit_coefficient(mu_x, mu_y, beta):
+    """|t_T| / p on the slip ellipse (91) for a traction at inclination beta [rad]."""
+    return 1.0 / np.hypot(np.cos(beta) / mu_x, np.sin(beta) / mu_y)

@@ -1,0 +1,855 @@
+"""Tabulated normal law of a rough interface: pressure p(h), stiffness k(h), area fraction A/A0.
+
+Units: separation h of the mean planes [mm], pressure p = W/A0 [MPa], normal stiffness per unit
+nominal area k = -dp/dh [MPa/mm], its derivative dk/dh [MPa/mm^2], real-area fraction a = A/A0 [-].
+
+The population integrals of :mod:`rough_contact.population` cost far too much to be evaluated at
+every facet quadrature point of every Newton iteration, so :class:`NormalLaw` replaces them by an
+interpolant built once per surface and material:
+
+* **Table** ``h_min <= h <= h_table_end``: piecewise cubic Hermite interpolation of ``ln p`` in h,
+  with the model's own stiffness as derivative data (``d ln p/dh = -k/p``), on knots refined
+  adaptively by interval bisection (with 2:1 grading of neighbouring intervals). ``ln a`` is
+  interpolated on the same knots (cubic Hermite, second-order three-point slopes with the
+  Fritsch-Carlson limiter). Refinement stops when every interval passes its check against the
+  model: ``check="quarter"`` compares p, k, a at t = 1/4, 1/2, 3/4 of the interval with tolerance
+  ``rtol/2``; ``check="midpoint"`` (default of the population constructors, about half the model
+  evaluations) compares at t = 1/2 only and bounds the stiffness error by the asymptotic Hermite
+  ratio (slope error <= 3.08/dx times the mid-interval value error) and the area error by 4x its
+  mid-interval value. Errors are relative to max(|value|, ``floor`` x value at h_min). The stated
+  accuracy, max relative error of p, k and a <= ``rtol`` at *any* point of the table, is what the
+  tests and ``benchmarks/bench_normal_law.py`` verify against the direct population integral.
+  Every interval is also required to be in the exact Fritsch-Carlson monotonicity region, so the
+  interpolant of p is non-increasing everywhere (k >= 0), and k is the *exact* derivative of the
+  interpolant (consistent tangent: Newton converges quadratically). p is C1 (k is continuous);
+  dk/dh is exact inside every interval (it jumps at knots).
+* **Taper** ``h_table_end < h < h_max``: ``p = P (1 - t)^3``, ``t = (h - h_table_end)/L`` with
+  ``L = 3 P/K`` where P, K are the table's end values; this is the cubic Hermite curve from
+  (P, slope -K) to (0, slope 0), monotone, C1 at both ends (and C2 at ``h_max``). The model's
+  pressure at ``h_table_end`` is at most ``tail`` (default 1e-12) times its value at the mean plane,
+  so the taper changes p by a negligible absolute amount; relative accuracy is not claimed there.
+  ``a`` is tapered the same way, ``a_end (1 - t)^3``.
+* **Out of contact** ``h >= h_max``: ``p = k = a = dk/dh = 0`` exactly (no contact, no jump).
+* **Below validity** ``h < h_min``: the population models lose their meaning as A/A0 grows
+  (asperities interact, the bulk deforms); ``h_min`` is where the model's A/A0 reaches
+  ``area_limit`` (default 0.3) or ``depth`` (default 3) standard deviations of the surface heights
+  below the mean plane, whichever is higher. Below it the law continues as a stiff C1 (C2 where
+  possible) penalty: ``p = p0 + k0 d + c d^2/2``, ``k = k0 + c d``, ``d = h_min - h``, with
+  ``c = max(-dk/dh(h_min), 0)`` so that the stiffness keeps growing; A/A0 continues as
+  ``1 - (1 - a0) exp(-s d)`` (C1, approaching 1). :meth:`NormalLaw.count_below_validity` reports how
+  many points are there; the results at such points are a regularisation, not the micro-model.
+  All results are finite for every h down to ``h_min - d_max`` (d_max ~ 1e140 mm or more: the
+  depth where p would reach 1e300 MPa); deeper h, -inf and NaN raise ValueError (an iterate that
+  far is a diverged Newton iteration). h = +inf gives zeros.
+
+Loading history: this law is **reversible** — unloading follows the loading curve, also for the
+elasto-plastic population, whose asperities would in reality unload elastically from a permanently
+flattened shape. An irreversible unloading branch (a history variable holding the smallest
+separation reached) is a documented later step.
+
+Lookup is O(1) per point: a uniform look-up table over [h_min, h_table_end] whose cells are no
+wider than the shortest interval maps a point to its interval with one gather and one comparison.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable, Optional, Tuple
+
+import numpy as np
+
+__all__ = ["NormalLaw"]
+
+Model = Callable[[np.ndarray], Tuple[np.ndarray, np.ndarray, np.ndarray]]
+
+# Check points inside every interval (fractions of its width): t = 1/2 is where the value error of
+# a cubic Hermite interpolant peaks, t = 1/4 and 3/4 are next to where the slope error peaks
+# (t = 1/2 -/+ 1/sqrt(12)).
+_CHECK_T = np.array([0.25, 0.5, 0.75])
+_MAX_LUT = 1 << 22
+_BLOCK = 4096
+
+
+# ----------------------------------------------------------------------------------------------
+# validation helpers
+# ----------------------------------------------------------------------------------------------
+def _positive_scalar(name: str, value, allow_zero: bool = False) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a real number, got {value!r}") from None
+    ok = np.isfinite(v) and (v >= 0.0 if allow_zero else v > 0.0)
+    if not ok:
+        rng = "[0, inf)" if allow_zero else "(0, inf)"
+        raise ValueError(f"{name} = {value!r} is outside the valid range {rng}")
+    return v
+
+
+def _check_rtol(rtol) -> float:
+    r = _positive_scalar("rtol", rtol)
+    if not (1e-12 <= r <= 0.1):
+        raise ValueError(f"rtol = {rtol!r} is outside the valid range [1e-12, 0.1]")
+    return r
+
+
+def _model_values(model: Model, h: np.ndarray) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Call the model and validate its output (finite, p > 0, k >= 0, 0 < a <= 1)."""
+    out = model(h)
+    try:
+        p, k, a = (np.asarray(v, dtype=float).reshape(h.shape) for v in out)
+    except (TypeError, ValueError):
+        raise ValueError(
+            "the model must return three arrays (pressure, stiffness, area_fraction) "
+            f"shaped like h {h.shape}") from None
+    for name, v in (("pressure", p), ("stiffness", k), ("area_fraction", a)):
+        bad = ~np.isfinite(v)
+        if bad.any():
+            j = int(np.flatnonzero(bad)[0])
+            raise ValueError(f"model {name} is not finite at {int(bad.sum())} separations, "
+                             f"e.g. {name}({h.flat[j]!r} mm) = {v.flat[j]!r}")
+    for name, v, lo_ok, rng in (("pressure", p, p > 0, "(0, inf) MPa"),
+                                ("stiffness", k, k >= 0, "[0, inf) MPa/mm"),
+                                ("area_fraction", a, (a > 0) & (a <= 1), "(0, 1]")):
+        if not lo_ok.all():
+            j = int(np.flatnonzero(~lo_ok)[0])
+            raise ValueError(f"model {name}({h.flat[j]!r} mm) = {v.flat[j]!r} is outside the valid "
+                             f"range {rng} inside the table range")
+    return p, k, a
+
+
+# ----------------------------------------------------------------------------------------------
+# cubic Hermite helpers (coefficients in the local coordinate t in [0, 1])
+# ----------------------------------------------------------------------------------------------
+def _hermite_coeffs(y0, y1, d0, d1, dx) -> np.ndarray:
+    """Coefficients (4, n) of y(t) = c0 + c1 t + c2 t^2 + c3 t^3 with slopes d0, d1 per unit h."""
+    m0 = d0 * dx
+    m1 = d1 * dx
+    dy = y1 - y0
+    return np.stack([y0, m0, 3.0 * dy - 2.0 * m0 - m1, -2.0 * dy + m0 + m1])
+
+
+def _horner(c, t):
+    return c[0] + t * (c[1] + t * (c[2] + t * c[3]))
+
+
+def _horner_dt(c, t):
+    return c[1] + t * (2.0 * c[2] + t * (3.0 * c[3]))
+
+
+def _monotone_hermite(dy, m0, m1) -> np.ndarray:
+    """True where the cubic Hermite segment (secant dy, end slopes m0, m1 in t) is monotone.
+
+    Exact Fritsch-Carlson (1980) region for alpha = m0/dy, beta = m1/dy.
+    """
+    with np.errstate(divide="ignore", invalid="ignore"):
+        al = m0 / dy
+        be = m1 / dy
+        s = al + be - 2.0
+        phi = al - (2.0 * al + be - 3.0) ** 2 / (3.0 * s)
+    zero = dy == 0.0
+    ok = (al >= 0) & (be >= 0) & ((s <= 0) | (2 * al + be - 3 <= 0) | (al + 2 * be - 3 <= 0)
+                                  | (phi >= 0))
+    return np.where(zero, (m0 == 0) & (m1 == 0), ok)
+
+
+def _limited_slopes(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """Second-order three-point slopes of y(x) at the knots, limited to keep y monotone.
+
+    Interior knots: the derivative of the parabola through three neighbours; end knots: the
+    one-sided three-point formula. Then the Fritsch-Carlson limiter: a slope of the wrong sign (or
+    next to a flat secant) is set to zero, and slopes are scaled into the circle
+    alpha^2 + beta^2 <= 9, which keeps every segment monotone.
+    """
+    dx = np.diff(x)
+    sec = np.diff(y) / dx
+    d = np.empty_like(y)
+    if len(x) == 2:
+        d[:] = sec[0]
+        return d
+    hl, hr = dx[:-1], dx[1:]
+    d[1:-1] = (hr * sec[:-1] + hl * sec[1:]) / (hl + hr)
+    d[0] = ((2 * dx[0] + dx[1]) * sec[0] - dx[0] * sec[1]) / (dx[0] + dx[1])
+    d[-1] = ((2 * dx[-1] + dx[-2]) * sec[-1] - dx[-1] * sec[-2]) / (dx[-1] + dx[-2])
+    # sign limiter: the slope must have the sign of both adjacent secants
+    left = np.concatenate([sec[:1], sec])
+    right = np.concatenate([sec, sec[-1:]])
+    same = (np.sign(d) == np.sign(left)) & (np.sign(d) == np.sign(right))
+    d = np.where(same, d, 0.0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        al = np.where(sec != 0, d[:-1] / sec, 0.0)
+        be = np.where(sec != 0, d[1:] / sec, 0.0)
+        r = np.hypot(al, be)
+        tau = np.where(r > 3.0, 3.0 / r, 1.0)
+    fac = np.ones_like(d)
+    fac[:-1] = tau
+    fac[1:] = np.minimum(fac[1:], tau)
+    return d * fac
+
+
+# ----------------------------------------------------------------------------------------------
+# adaptive table
+# ----------------------------------------------------------------------------------------------
+def _adaptive_table(model: Model, h_lo: float, h_hi: float, rtol: float, n_initial: int,
+                    max_knots: int, floors: Tuple[float, float, float], check: str = "quarter"):
+    """Refine knots on [h_lo, h_hi] until the log-Hermite interpolant meets rtol/2 at check points.
+
+    Returns knots h (N+1,), and the model's p, k, a there, plus the number of model evaluations.
+    """
+    tol = 0.5 * rtol
+    fp, fk, fa = floors
+    if check == "quarter":
+        check_t, mid = _CHECK_T, 1
+    elif check == "midpoint":
+        check_t, mid = np.array([0.5]), 0
+    else:
+        raise ValueError(f"check = {check!r} is invalid: valid values are 'quarter', 'midpoint'")
+    nt = check_t.size
+    h = np.linspace(h_lo, h_hi, n_initial + 1)
+    p, k, a = _model_values(model, h)
+    n_eval = h.size
+    # check-point data of every interval, (n_int, nt); NaN where not evaluated yet
+    cp = np.full((n_initial, nt), np.nan)
+    ck = cp.copy()
+    ca = cp.copy()
+    for _ in range(200):
+        need = np.isnan(cp[:, 0])
+        if need.any():
+            idx = np.flatnonzero(need)
+            hx = h[idx, None] + (h[idx + 1] - h[idx])[:, None] * check_t[None, :]
+            pv, kv, av = _model_values(model, hx)
+            n_eval += hx.size
+            cp[idx], ck[idx], ca[idx] = pv, kv, av
+        dxs = np.diff(h)
+        q = np.log(p)
+        dq = -k / p
+        la = np.log(a)
+        if np.any(np.diff(q) > 0):
+            j = int(np.flatnonzero(np.diff(q) > 0)[0])
+            raise ValueError(
+                f"model pressure is not non-increasing: p({h[j]!r} mm) = {p[j]!r} MPa < "
+                f"p({h[j + 1]!r} mm) = {p[j + 1]!r} MPa")
+        dla = _limited_slopes(h, la)
+        cq = _hermite_coeffs(q[:-1], q[1:], dq[:-1], dq[1:], dxs)
+        ca_ = _hermite_coeffs(la[:-1], la[1:], dla[:-1], dla[1:], dxs)
+        t = check_t[None, :]
+        pi = np.exp(_horner(cq[:, :, None], t))
+        ki = -pi * _horner_dt(cq[:, :, None], t) / dxs[:, None]
+        ai = np.exp(_horner(ca_[:, :, None], t))
+        err = np.maximum.reduce([
+            np.abs(pi - cp) / np.maximum(cp, fp),
+            np.abs(ki - ck) / np.maximum(ck, fk),
+            np.abs(ai - ca) / np.maximum(ca, fa),
+        ]).max(axis=1)
+        if check == "midpoint":
+            # The slope error of a cubic Hermite interpolant is (asymptotically) largest at
+            # t = 1/2 -/+ 1/sqrt(12), where it is 3.08/dx times the value error at t = 1/2; the
+            # relative stiffness error is that of d(ln p)/dh.
+            eq = np.abs(_horner(cq, 0.5) - np.log(cp[:, 0]))
+            qmin = np.minimum(np.abs(dq[:-1]), np.abs(dq[1:]))
+            with np.errstate(divide="ignore", invalid="ignore"):
+                est = np.where(qmin > 0, 3.08 * eq / (dxs * qmin), 0.0)
+            # ln a uses three-point slopes: its error is not symmetric about t = 1/2 and peaks
+            # up to ~3x higher elsewhere in the interval (measured), hence the factor 4
+            ea = 4.0 * np.abs(ai[:, 0] - ca[:, 0]) / np.maximum(ca[:, 0], fa)
+            err = np.maximum.reduce([err, est, ea])
+        mono = _monotone_hermite(np.diff(q), dq[:-1] * dxs, dq[1:] * dxs)
+        fail = (err > tol) | ~mono
+        # 2:1 grading (an interval is at most twice as wide as its neighbours): keeps the
+        # three-point slopes of ln a accurate and makes refinement fronts advance in one round
+        nb = np.minimum(np.concatenate([[np.inf], dxs[:-1]]), np.concatenate([dxs[1:], [np.inf]]))
+        fail |= dxs > 2.0 * nb * (1.0 + 1e-9)
+        if not fail.any():
+            return h, p, k, a, n_eval, float(err.max())
+        if h.size + fail.sum() > max_knots:
+            raise ValueError(
+                f"rtol = {rtol!r} could not be reached with max_knots = {max_knots} knots (worst "
+                f"relative error {err.max():.3g} near h = {h[np.argmax(err)]!r} mm): the model is "
+                "probably less accurate than rtol (loosen rtol to at least the model's own "
+                "accuracy), or its stiffness is not the derivative of its pressure")
+        fi = np.flatnonzero(fail)
+        # split failing intervals at their midpoints (check point t = 1/2 becomes a knot)
+        hm = 0.5 * (h[fi] + h[fi + 1])
+        pos = fi + 1
+        h = np.insert(h, pos, hm)
+        p = np.insert(p, pos, cp[fi, mid])
+        k = np.insert(k, pos, ck[fi, mid])
+        a = np.insert(a, pos, ca[fi, mid])
+        # interval fi becomes two: both need fresh check points
+        keep = ~fail
+        new_n = h.size - 1
+        ncp = np.full((new_n, nt), np.nan)
+        nck = ncp.copy()
+        nca = ncp.copy()
+        # index of old interval j in the new list: j + (number of failing intervals before j)
+        shift = np.cumsum(fail) - fail
+        newpos = np.arange(fail.size) + shift
+        ncp[newpos[keep]] = cp[keep]
+        nck[newpos[keep]] = ck[keep]
+        nca[newpos[keep]] = ca[keep]
+        cp, ck, ca = ncp, nck, nca
+    raise ValueError(f"rtol = {rtol!r}: table refinement did not converge in 200 rounds")
+
+
+# ----------------------------------------------------------------------------------------------
+# the law
+# ----------------------------------------------------------------------------------------------
+@dataclass(frozen=True, eq=False)
+class NormalLaw:
+    """Reversible normal law p(h), k(h) = -dp/dh, A/A0(h) of a rough interface (see module doc).
+
+    Build it with one of the constructors, not directly:
+    :meth:`elastic`, :meth:`elasto_plastic`, :meth:`greenwood_williamson` (population models of
+    :mod:`rough_contact.population`), :meth:`from_model` (any callable) or :meth:`from_table`
+    (user data, e.g. measured).
+
+    Attributes:
+        knots: (N+1,) table knots [mm], ``knots[0] == h_min``, ``knots[-1] == h_table_end``.
+        h_min: lower validity limit of the table [mm]; below it a stiff C1 continuation.
+        h_table_end: last tabulated separation [mm]; the C1 taper starts there.
+        h_max: p == 0 exactly for h >= h_max [mm].
+        rtol: relative accuracy of p, k and A/A0 against the model inside the table (None for
+            :meth:`from_table`, which interpolates data).
+        has_area: False when built from a table without area data (then a == 0 is returned).
+        info: dict with build statistics (model evaluations, worst check-point error, ...).
+    """
+
+    knots: np.ndarray
+    _qc: np.ndarray          # (4, N) Hermite coefficients of ln p in t
+    _ac: np.ndarray          # (4, N) Hermite coefficients of ln a in t (unused if not has_area)
+    _inv: np.ndarray         # (N,) 1/interval width [1/mm]
+    _next: np.ndarray        # (N,) right knot of every interval, last = +inf
+    _lut: np.ndarray         # (M+1,) interval index at the left end of every look-up cell
+    _lut_inv: float          # 1/cell width [1/mm]
+    has_area: bool
+    rtol: Optional[float]
+    # below-validity continuation
+    _p0: float
+    _k0: float
+    _c0: float
+    _a0: float
+    _s0: float
+    _d_max: float            # deepest d = h_min - h with a representable penalty pressure
+    # taper
+    _pe: float
+    _ae: float
+    _taper: float            # L [mm]
+    info: dict = field(default_factory=dict)
+
+    # ------------------------------------------------------------------ construction helpers
+    @property
+    def h_min(self) -> float:
+        return float(self.knots[0])
+
+    @property
+    def h_table_end(self) -> float:
+        return float(self.knots[-1])
+
+    @property
+    def h_max(self) -> float:
+        return float(self.knots[-1] + self._taper)
+
+    @property
+    def n_intervals(self) -> int:
+        return int(self.knots.size - 1)
+
+    @classmethod
+    def _assemble(cls, h, q, dq, la, dla, has_area, rtol, info) -> "NormalLaw":
+        h = np.asarray(h, float)
+        dx = np.diff(h)
+        qc = _hermite_coeffs(q[:-1], q[1:], dq[:-1], dq[1:], dx)
+        if has_area:
+            ac = _hermite_coeffs(la[:-1], la[1:], dla[:-1], dla[1:], dx)
+        else:
+            ac = np.zeros_like(qc)
+        n = dx.size
+        # look-up table: cells no wider than the shortest interval, so that each cell holds at
+        # most one interior knot and one comparison finds the interval.
+        span = h[-1] - h[0]
+        m = int(np.ceil(span / dx.min() * (1.0 + 1e-9))) + 1
+        if m > _MAX_LUT:
+            raise ValueError(f"table knots too uneven: the look-up table would need {m} cells "
+                             f"(valid range: <= {_MAX_LUT}); shortest interval {dx.min()!r} mm "
+                             f"over {span!r} mm")
+        lut_inv = m / span
+        edges = h[0] + np.arange(m + 1) / lut_inv
+        lut = np.clip(np.searchsorted(h, edges, side="right") - 1, 0, n - 1).astype(np.intp)
+        nxt = h[1:].copy()
+        nxt[-1] = np.inf
+        # end values of p, k, dk/dh, a, da/dh at both table ends
+        p_lo, p_hi = np.exp(q[0]), np.exp(q[-1])
+        k_lo, k_hi = -p_lo * dq[0], -p_hi * dq[-1]
+        d2q_lo = 2.0 * qc[2, 0] * (1.0 / dx[0]) ** 2
+        dk_lo = -p_lo * (dq[0] ** 2 + d2q_lo)
+        if k_hi <= 0:
+            raise ValueError(f"stiffness at the end of the table h = {h[-1]!r} mm is {k_hi!r} "
+                             "MPa/mm; it must be > 0 to taper the pressure to zero")
+        if has_area:
+            a_lo, a_hi = np.exp(la[0]), np.exp(la[-1])
+            da_lo = a_lo * dla[0]
+            s0 = -da_lo / (1.0 - a_lo) if a_lo < 1.0 else 0.0
+        else:
+            a_lo = a_hi = 0.0
+            s0 = 0.0
+        # p0 + k0 d + c d^2/2 <= 1e300 (finite, with margin) for d <= d_max
+        c_lo = max(-dk_lo, 0.0)
+        d_max = min(3e299 / k_lo if k_lo > 0 else np.inf,
+                    np.sqrt(6e299 / c_lo) if c_lo > 0 else np.inf)
+        for arr in (h, qc, ac, nxt, lut):
+            arr.setflags(write=False)
+        return cls(knots=h, _qc=qc, _ac=ac, _inv=1.0 / dx, _next=nxt, _lut=lut,
+                   _lut_inv=float(lut_inv), has_area=bool(has_area), rtol=rtol,
+                   _p0=float(p_lo), _k0=float(k_lo), _c0=float(max(-dk_lo, 0.0)), _a0=float(a_lo),
+                   _s0=float(max(s0, 0.0)), _d_max=float(d_max), _pe=float(p_hi), _ae=float(a_hi),
+                   _taper=float(3.0 * p_hi / k_hi), info=info)
+
+    # ------------------------------------------------------------------ constructors
+    @classmethod
+    def from_model(cls, model: Model, h_range: Tuple[float, float], rtol: float = 1e-5, *,
+                   n_initial: int = 16, max_knots: int = 20000,
+                   floor: float = 1e-15, check: str = "quarter") -> "NormalLaw":
+        """Build the law from any model ``h -> (p, k, a)`` on ``h_range = (h_min, h_table_end)``.
+
+        Args:
+            model: vectorised callable; given h (any shape, mm) returns pressure [MPa] > 0,
+                stiffness -dp/dh [MPa/mm] >= 0 and area fraction in (0, 1], each shaped like h,
+                with p non-increasing. Its k must be the derivative of its p to within rtol.
+            h_range: (h_min, h_table_end) [mm], h_min < h_table_end. p must be > 0 on it. Below
+                h_min the stiff continuation applies; beyond h_table_end the taper to zero.
+            rtol: relative accuracy of p, k and a at every point of the table, in [1e-12, 0.1].
+            n_initial: number of uniform intervals to start refining from.
+            max_knots: refinement limit; exceeding it raises ValueError.
+            floor: errors are relative to max(|value|, floor * value at h_min) (guards zeros).
+            check: "quarter" compares p, k, a with the model at t = 1/4, 1/2, 3/4 of every
+                interval (3 model evaluations per interval, robust); "midpoint" only at t = 1/2
+                and bounds the stiffness error by the asymptotic Hermite error ratio (about 3x
+                fewer model evaluations, for expensive models).
+
+        Raises:
+            ValueError: bad arguments, a model returning non-finite / out-of-range values or a
+                non-monotone pressure, or an rtol the model cannot support.
+        """
+        rtol = _check_rtol(rtol)
+        try:
+            h_lo, h_hi = (float(v) for v in h_range)
+        except (TypeError, ValueError):
+            raise ValueError(f"h_range must be two numbers (h_min, h_table_end) in mm, got "
+                             f"{h_range!r}") from None
+        if not (np.isfinite(h_lo) and np.isfinite(h_hi) and h_lo < h_hi):
+            raise ValueError(f"h_range = {h_range!r} mm must be finite with h_min < h_table_end")
+        n_initial = int(n_initial)
+        if n_initial < 2:
+            raise ValueError(f"n_initial = {n_initial} is outside the valid range [2, inf)")
+        p_ref, k_ref, a_ref = (float(v[0]) for v in _model_values(model, np.array([h_lo])))
+        floors = (floor * p_ref, floor * k_ref, floor * a_ref)
+        h, p, k, a, n_eval, worst = _adaptive_table(model, h_lo, h_hi, rtol, n_initial,
+                                                    int(max_knots), floors, check)
+        q, la = np.log(p), np.log(a)
+        info = {"model_evaluations": n_eval + 1, "worst_checkpoint_error": worst,
+                "knots": h.size}
+        return cls._assemble(h, q, -k / p, la, _limited_slopes(h, la), True, rtol, info)
+
+    @classmethod
+    def from_table(cls, h, p, a=None) -> "NormalLaw":
+        """Build the law from tabulated data (e.g. measured), interpolated monotonically.
+
+        ``ln p`` is interpolated by monotone PCHIP (Fritsch-Butland slopes, as
+        :class:`scipy.interpolate.PchipInterpolator`), so p is non-increasing and C1 and k is the
+        exact derivative of the interpolant; ``ln a`` likewise when a is given.
+
+        Args:
+            h: (n,) separations [mm], finite, strictly increasing, n >= 3.
+            p: (n,) pressures [MPa], finite, > 0, strictly decreasing.
+            a: optional (n,) area fractions A/A0 in (0, 1], non-increasing. Without it,
+                ``evaluate`` returns a == 0 and ``has_area`` is False.
+
+        Below ``h[0]`` the stiff continuation applies, beyond ``h[-1]`` the cubic taper to zero
+        over L = 3 p_end/k_end (so p == 0 from ``h_max = h[-1] + L``): end the data where the
+        pressure is negligible if the taper matters.
+        """
+        from scipy.interpolate import PchipInterpolator
+
+        h = np.array(h, dtype=float).ravel()
+        p = np.array(p, dtype=float).ravel()
+        if h.size < 3 or p.size != h.size:
+            raise ValueError(f"from_table needs h and p of equal length >= 3, got {h.size} and "
+                             f"{p.size}")
+        for name, v in (("h", h), ("p", p)):
+            if not np.isfinite(v).all():
+                raise ValueError(f"table {name} has {int((~np.isfinite(v)).sum())} non-finite "
+                                 "entries; valid: finite numbers")
+        if np.any(np.diff(h) <= 0):
+            j = int(np.flatnonzero(np.diff(h) <= 0)[0])
+            raise ValueError(f"table h must be strictly increasing: h[{j}] = {h[j]!r}, "
+                             f"h[{j + 1}] = {h[j + 1]!r} mm")
+        if np.any(p <= 0):
+            j = int(np.flatnonzero(p <= 0)[0])
+            raise ValueError(f"table p[{j}] = {p[j]!r} MPa is outside the valid range (0, inf)")
+        if np.any(np.diff(p) >= 0):
+            j = int(np.flatnonzero(np.diff(p) >= 0)[0])
+            raise ValueError(f"table p must be strictly decreasing in h: p[{j}] = {p[j]!r}, "
+                             f"p[{j + 1}] = {p[j + 1]!r} MPa")
+        q = np.log(p)
+        dq = np.minimum(PchipInterpolator(h, q).derivative()(h), 0.0)
+        if dq[-1] == 0.0:
+            # PCHIP zeroes a one-sided end slope of the wrong sign; the taper needs k > 0 at the
+            # table end: half the last secant keeps the segment monotone (Fritsch-Carlson region
+            # for any alpha in [0, 3])
+            dq[-1] = 0.5 * (q[-1] - q[-2]) / (h[-1] - h[-2])
+        dxs = np.diff(h)
+        if not np.all(_monotone_hermite(np.diff(q), dq[:-1] * dxs, dq[1:] * dxs)):
+            raise ValueError("internal error: PCHIP slopes of ln p are not monotone")
+        has_area = a is not None
+        la = dla = None
+        if has_area:
+            a = np.array(a, dtype=float).ravel()
+            if a.size != h.size or not np.isfinite(a).all():
+                raise ValueError(f"table a must have {h.size} finite entries, got {a.size}")
+            if np.any((a <= 0) | (a > 1)):
+                j = int(np.flatnonzero((a <= 0) | (a > 1))[0])
+                raise ValueError(f"table a[{j}] = {a[j]!r} is outside the valid range (0, 1]")
+            if np.any(np.diff(a) > 0):
+                j = int(np.flatnonzero(np.diff(a) > 0)[0])
+                raise ValueError(f"table a must be non-increasing in h: a[{j}] = {a[j]!r}, "
+                                 f"a[{j + 1}] = {a[j + 1]!r}")
+            la = np.log(a)
+            dla = np.minimum(PchipInterpolator(h, la).derivative()(h), 0.0)
+        info = {"knots": h.size, "source": "table"}
+        return cls._assemble(h, q, dq, la, dla, has_area, None, info)
+
+    @classmethod
+    def _from_population(cls, fn, surface, param, rtol, area_limit, depth, tail, kwargs, name,
+                         check):
+        rtol = _check_rtol(rtol)
+        area_limit = _positive_scalar("area_limit", area_limit)
+        if area_limit >= 1.0:
+            raise ValueError(f"area_limit = {area_limit!r} is outside the valid range (0, 1)")
+        depth = _positive_scalar("depth", depth, allow_zero=True)
+        tail = _positive_scalar("tail", tail)
+        if tail >= 1e-2:
+            raise ValueError(f"tail = {tail!r} is outside the valid range (0, 1e-2)")
+
+        calls = [0]
+
+        def model(h):
+            calls[0] += np.size(h)
+            r = fn(surface, param, h, **kwargs)
+            return r.pressure, r.stiffness, r.area_fraction
+
+        sigma = float(np.sqrt(surface.m00))   # rms height [mm] (m00 stored in mm^2)
+        # coarse scan in steps of sigma/2, from `depth` sigma below the mean plane upwards
+        grid = np.arange(-depth, 12.0 + 1e-9, 0.5) * sigma
+        p_g, k_g, a_g = (np.asarray(v, float) for v in model(grid))
+        if not (np.all(np.isfinite(a_g)) and np.all(np.isfinite(p_g))):
+            raise ValueError(f"{name} model returned non-finite values on the range "
+                             f"[{grid[0]!r}, {grid[-1]!r}] mm")
+        # --- h_min: where A/A0 falls to area_limit, but not below -depth sigma
+        above = a_g > area_limit
+        if not above[0]:
+            h_lo = float(grid[0])
+        else:
+            if above[-1]:
+                raise ValueError(f"{name} model A/A0 stays above area_limit = {area_limit!r} up "
+                                 f"to h = {grid[-1]!r} mm (12 sigma)")
+            j = int(np.flatnonzero(above)[-1])   # last grid point above the limit
+            lo, hi = float(grid[j]), float(grid[j + 1])
+            for _ in range(2):                    # bracket shrinks 8x per round
+                sub = np.linspace(lo, hi, 9)[1:-1]
+                a_s = np.asarray(model(sub)[2], float)
+                up = np.flatnonzero(a_s > area_limit)
+                i = int(up[-1]) + 1 if up.size else 0
+                edges = np.concatenate([[lo], sub, [hi]])
+                lo, hi = float(edges[i]), float(edges[i + 1])
+            h_lo = hi                             # A/A0(h_min) <= area_limit, within sigma/128
+        # --- h_table_end: first scan point with p <= tail * p(max(h_min, 0)) (and p > 0)
+        p_ref = float(np.asarray(model(np.array([max(h_lo, 0.0)]))[0], float)[0])
+        for _ in range(2):
+            cand = np.flatnonzero((grid > h_lo) & (p_g <= tail * p_ref) & (p_g > 0))
+            if cand.size or grid[-1] > 30 * sigma:
+                break
+            grid = np.arange(12.5, 40.0 + 1e-9, 0.5) * sigma     # extend the scan to 40 sigma
+            p_g = np.asarray(model(grid)[0], float)
+        if cand.size:
+            h_hi = float(grid[cand[0]])
+        else:
+            pos = np.flatnonzero((grid > h_lo) & (p_g > 0))
+            # the model underflowed to p == 0 before reaching the tail ratio: accept its last
+            # positive value if it is already small
+            if pos.size == 0 or p_g[pos[-1]] > 1e-6 * p_ref:
+                raise ValueError(f"{name} model pressure does not fall to tail = {tail!r} times "
+                                 f"p_ref = {p_ref!r} MPa up to h = {grid[-1]!r} mm (40 sigma)")
+            h_hi = float(grid[pos[-1]])
+        n_scan = calls[0]
+        law = cls.from_model(model, (h_lo, h_hi), rtol, check=check)
+        law.info.update({"model": name, "sigma_mm": sigma, "area_limit": area_limit,
+                         "depth": depth, "tail": tail, "p_ref": p_ref,
+                         "range_scan_evaluations": n_scan,
+                         "model_evaluations": calls[0]})
+        return law
+
+    @classmethod
+    def elastic(cls, surface, E_star: float, rtol: float = 1e-4, *, area_limit: float = 0.3,
+                depth: float = 3.0, tail: float = 1e-12, check: str = "midpoint",
+                **model_kwargs) -> "NormalLaw":
+        """Law of the strongly anisotropic elastic population, eqs (52), (53), (55).
+
+        Args:
+            surface: :class:`rough_contact.surface.SpectralMoments`.
+            E_star: effective modulus E* [MPa].
+            rtol: relative accuracy of p, k and A/A0 against ``population.elastic`` (the
+                default 1e-4 is ~10x looser than the population quadrature's own accuracy at its
+                default ``n_quad``; tighten both together).
+            area_limit: A/A0 defining the lower validity limit h_min (see module doc).
+            depth: h_min is not below ``-depth * sqrt(m00)``.
+            tail: the table ends where p <= tail * p(max(h_min, 0)).
+            check: refinement check mode, see :meth:`from_model` ("midpoint": about half the
+                population evaluations of "quarter").
+            **model_kwargs: passed on to :func:`rough_contact.population.elastic`.
+        """
+        from rough_contact import population
+
+        _positive_scalar("E_star", E_star)
+        return cls._from_population(population.elastic, surface, E_star, rtol, area_limit,
+                                    depth, tail, model_kwargs, "elastic", check)
+
+    @classmethod
+    def elasto_plastic(cls, surface, material, rtol: float = 1e-4, *, area_limit: float = 0.3,
+                       depth: float = 3.0, tail: float = 1e-12, check: str = "midpoint",
+                       **model_kwargs) -> "NormalLaw":
+        """Law of the elasto-plastic population, eqs (78)-(88) (reversible, see module doc).
+
+        Args:
+            surface: :class:`rough_contact.surface.SpectralMoments`.
+            material: :class:`rough_contact.asperity.AsperityMaterial`.
+            rtol, area_limit, depth, tail: as in :meth:`elastic`.
+            **model_kwargs: passed on to :func:`rough_contact.population.elasto_plastic`.
+        """
+        from rough_contact import population
+
+        return cls._from_population(population.elasto_plastic, surface, material, rtol,
+                                    area_limit, depth, tail, model_kwargs, "elasto_plastic", check)
+
+    @classmethod
+    def greenwood_williamson(cls, surface, E_star: float, rtol: float = 1e-4, *,
+                             area_limit: float = 0.3, depth: float = 3.0, tail: float = 1e-12,
+                             check: str = "midpoint", **model_kwargs) -> "NormalLaw":
+        """Law of McCool's equivalent Greenwood-Williamson model (see EQUATIONS.md).
+
+        Args: as in :meth:`elastic`; **model_kwargs go to
+        :func:`rough_contact.population.greenwood_williamson`.
+        """
+        from rough_contact import population
+
+        _positive_scalar("E_star", E_star)
+        return cls._from_population(population.greenwood_williamson, surface, E_star, rtol,
+                                    area_limit, depth, tail, model_kwargs, "greenwood_williamson",
+                                    check)
+
+    # ------------------------------------------------------------------ evaluation
+    def _check_h(self, h) -> np.ndarray:
+        h = np.asarray(h, dtype=float)
+        if np.isnan(h).any():
+            raise ValueError(f"separation h has {int(np.isnan(h).sum())} NaN entries out of "
+                             f"{h.size}; valid range: (-inf, inf] mm")
+        return h
+
+    def evaluate(self, h, curvature: bool = False):
+        """Pressure, stiffness and area fraction at separations h.
+
+        Args:
+            h: separations of the mean planes [mm], any shape (typically (n,)); finite or +inf
+                (open). NaN or -inf raise ValueError.
+            curvature: also return dk/dh.
+
+        Returns:
+            ``(p, k, a)`` or, with ``curvature=True``, ``(p, k, a, dk_dh)``, each shaped like h:
+            p >= 0 [MPa], k = -dp/dh >= 0 [MPa/mm] (exact derivative of p),
+            a = A/A0 in [0, 1] [-], dk_dh [MPa/mm^2] (exact derivative of k).
+        """
+        h_in = self._check_h(h)
+        h = h_in.reshape(-1)
+        n = h.size
+        p = np.empty(n)
+        k = np.empty(n)
+        a = np.empty(n)
+        dk = np.empty(n) if curvature else None
+        # blocks keep the temporaries in cache (2-4x faster for large n than one pass)
+        for s in range(0, n, _BLOCK):
+            e = min(s + _BLOCK, n)
+            self._eval_block(h[s:e], p[s:e], k[s:e], a[s:e],
+                             None if dk is None else dk[s:e])
+        shape = h_in.shape
+        if curvature:
+            return p.reshape(shape), k.reshape(shape), a.reshape(shape), dk.reshape(shape)
+        return p.reshape(shape), k.reshape(shape), a.reshape(shape)
+
+    def _eval_block(self, h, p, k, a, dk) -> None:
+        """Evaluate one block of points into p, k, a, dk (in place), all three regions."""
+        knots = self.knots
+        h0 = knots[0]
+        hc = np.maximum(h, h0)
+        np.minimum(hc, knots[-1], out=hc)
+        x = hc - h0
+        x *= self._lut_inv
+        i = self._lut.take(x.astype(np.intp))
+        i += hc >= self._next.take(i)
+        inv = self._inv.take(i)
+        t = hc
+        t -= knots.take(i)
+        t *= inv
+        qc = self._qc
+        c1, c2, c3 = qc[1].take(i), qc[2].take(i), qc[3].take(i)
+        # p = exp(q(t)); dq/dt = c1 + 2 c2 t + 3 c3 t^2
+        np.multiply(t, c3, out=p)
+        p += c2
+        p *= t
+        p += c1
+        p *= t
+        p += qc[0].take(i)
+        np.exp(p, out=p)
+        c3 *= 3.0
+        c3 *= t
+        c2 *= 2.0
+        if dk is not None:
+            d2 = c3 * 2.0
+            d2 += c2                      # d2q/dt2 = 2 c2 + 6 c3 t
+        c3 += c2
+        c3 *= t
+        c3 += c1                          # dq/dt
+        c3 *= inv                         # dq/dh
+        np.multiply(p, c3, out=k)
+        np.negative(k, out=k)             # k = -p dq/dh
+        if dk is not None:
+            inv *= inv
+            d2 *= inv                     # d2q/dh2
+            np.multiply(c3, c3, out=dk)
+            dk += d2
+            dk *= p
+            np.negative(dk, out=dk)       # dk/dh = -p (q'^2 + q'')
+        if self.has_area:
+            ac = self._ac
+            np.multiply(t, ac[3].take(i), out=a)
+            a += ac[2].take(i)
+            a *= t
+            a += ac[1].take(i)
+            a *= t
+            a += ac[0].take(i)
+            np.exp(a, out=a)
+        else:
+            a[:] = 0.0
+        # below validity: stiff C1 continuation (C2 when -dk/dh(h_min) >= 0)
+        lo = h < h0
+        if lo.any():
+            lo = np.flatnonzero(lo)
+            d = h0 - h[lo]
+            if np.any(d > self._d_max):
+                if np.isinf(d).any():
+                    raise ValueError(f"separation h has {int(np.isinf(d).sum())} entries equal "
+                                     "to -inf; valid range: (-inf, inf] mm")
+                raise ValueError(
+                    f"{int((d > self._d_max).sum())} separations below "
+                    f"{h0 - self._d_max!r} mm (e.g. {h[lo][np.argmax(d)]!r} mm): the penalty "
+                    "continuation would overflow there; the iteration has diverged")
+            p[lo] = self._p0 + d * (self._k0 + 0.5 * self._c0 * d)
+            k[lo] = self._k0 + self._c0 * d
+            if dk is not None:
+                dk[lo] = -self._c0
+            if self.has_area:
+                a[lo] = 1.0 - (1.0 - self._a0) * np.exp(-self._s0 * d)
+        # taper (C1) and out of contact (exact zeros)
+        h1 = knots[-1]
+        hi = h > h1
+        if hi.any():
+            L = self._taper
+            out = h >= h1 + L
+            np.copyto(p, 0.0, where=out)
+            np.copyto(k, 0.0, where=out)
+            np.copyto(a, 0.0, where=out)
+            if dk is not None:
+                np.copyto(dk, 0.0, where=out)
+            tp = np.flatnonzero(hi & ~out)
+            if tp.size:
+                u = 1.0 - (h[tp] - h1) / L
+                p[tp] = self._pe * u ** 3
+                k[tp] = 3.0 * self._pe / L * u * u
+                if dk is not None:
+                    dk[tp] = -6.0 * self._pe / (L * L) * u
+                if self.has_area:
+                    a[tp] = self._ae * u ** 3
+
+    def below_validity(self, h) -> np.ndarray:
+        """Boolean mask, shaped like h: True where h < h_min (stiff continuation, not the model)."""
+        return self._check_h(h) < self.knots[0]
+
+    def count_below_validity(self, h) -> int:
+        """Number of separations below h_min (where the penalty continuation is used)."""
+        return int(np.count_nonzero(self.below_validity(h)))
+
+    def separation_for_pressure(self, p) -> np.ndarray:
+        """Inverse of p(h): the separation at which the law gives pressure p (vectorised).
+
+        Args:
+            p: pressures [MPa], any shape, finite and >= 0. p == 0 returns h_max (the smallest
+                separation with zero pressure).
+
+        Returns:
+            h [mm], shaped like p, with ``evaluate(h)[0] == p`` to round-off.
+        """
+        p = np.asarray(p, dtype=float)
+        bad = ~np.isfinite(p) | (p < 0)
+        if bad.any():
+            j = int(np.flatnonzero(bad.ravel())[0])
+            raise ValueError(f"pressure p has {int(bad.sum())} entries outside the valid range "
+                             f"[0, inf) MPa, e.g. {p.ravel()[j]!r}")
+        pf = p.ravel()
+        out = np.empty_like(pf)
+        knots = self.knots
+        qk = np.concatenate([self._qc[0], [self._qc[:, -1].sum()]])   # ln p at the knots
+        p_hi = self._pe
+        # table
+        mt = (pf >= p_hi) & (pf <= self._p0)
+        if mt.any():
+            qt = np.log(pf[mt])
+            # qk is non-increasing: find i with qk[i] >= qt >= qk[i+1]
+            i = np.searchsorted(-qk, -qt, side="left") - 1
+            i = np.clip(i, 0, knots.size - 2)
+            c = self._qc[:, i]
+            lo = np.zeros_like(qt)
+            hi_ = np.ones_like(qt)
+            dqi = qk[i + 1] - qk[i]
+            with np.errstate(divide="ignore", invalid="ignore"):
+                t = np.where(dqi != 0, (qt - qk[i]) / dqi, 0.0)
+            t = np.clip(t, 0.0, 1.0)
+            for _ in range(100):   # safeguarded Newton on the monotone cubic
+                f = _horner(c, t) - qt
+                lo = np.where(f > 0, t, lo)      # q decreasing: f > 0 means t too small
+                hi_ = np.where(f > 0, hi_, t)
+                df = _horner_dt(c, t)
+                with np.errstate(divide="ignore", invalid="ignore"):
+                    tn = t - f / df
+                bis = ~np.isfinite(tn) | (tn <= lo) | (tn >= hi_)
+                tn = np.where(bis, 0.5 * (lo + hi_), tn)
+                done = np.abs(tn - t) <= 4e-16
+                t = tn
+                if done.all():
+                    break
+            out[mt] = knots[i] + t / self._inv[i]
+        # below validity
+        mb = pf > self._p0
+        if mb.any():
+            dp = pf[mb] - self._p0
+            if self._c0 > 0:
+                d = 2.0 * dp / (self._k0 + np.sqrt(self._k0 ** 2 + 2.0 * self._c0 * dp))
+            else:
+                d = dp / self._k0
+            out[mb] = knots[0] - d
+        # taper
+        mz = pf < p_hi
+        if mz.any():
+            s = 1.0 - np.cbrt(pf[mz] / p_hi)
+            out[mz] = knots[-1] + s * self._taper
+        return out.reshape(p.shape)
+
+    def __repr__(self) -> str:
+        src = self.info.get("model", self.info.get("source", "model"))
+        return (f"NormalLaw({src}, {self.n_intervals} intervals, h_min={self.h_min:.6g} mm, "
+                f"h_max={self.h_max:.6g} mm, rtol={self.rtol})")

@@ -1,0 +1,87 @@
+"""Per-point history of the interface law: committed and trial arrays.
+
+Units: slips in mm, dissipated energy per nominal area in N/mm (= MPa mm).
+
+The trial state is recomputed from the committed one at every law evaluation (the law is a
+pure function); ``StatePair.commit`` runs once per converged load increment and
+``StatePair.revert`` after a failed one, before the cutback.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["InterfaceState", "StatePair"]
+
+
+@dataclass
+class InterfaceState:
+    """History at n interface points (arrays batch-first).
+
+    Attributes:
+        plastic_slip: (n, 2) irreversible slip s_p in local axes (x, y) [mm].
+        accumulated_slip: (n, 2) sum of |Delta s_p,x|, |Delta s_p,y| [mm]; hardening variables
+            of the orthotropic law (89)-(90).
+        slip_path: (n,) sum of ||Delta s_p|| [mm]; hardening variable of the isotropic law (119).
+        dissipated: (n,) cumulative frictional dissipation sum t_T . Delta s_p [N/mm].
+    """
+
+    plastic_slip: np.ndarray
+    accumulated_slip: np.ndarray
+    slip_path: np.ndarray
+    dissipated: np.ndarray
+
+    def __post_init__(self) -> None:
+        n = np.shape(self.plastic_slip)[0] if np.ndim(self.plastic_slip) == 2 else -1
+        for name, shape in (("plastic_slip", (n, 2)), ("accumulated_slip", (n, 2)),
+                            ("slip_path", (n,)), ("dissipated", (n,))):
+            arr = getattr(self, name)
+            if not isinstance(arr, np.ndarray) or arr.shape != shape or n < 0:
+                want = shape if n >= 0 else "(n, 2)"
+                raise ValueError(f"InterfaceState.{name} must be an ndarray of shape {want}, "
+                                 f"got {np.shape(arr)}")
+
+    @classmethod
+    def zeros(cls, n_pts: int) -> InterfaceState:
+        """Virgin state (no slip, no hardening) at n_pts points."""
+        n = int(n_pts)
+        if n < 0:
+            raise ValueError(f"n_pts = {n_pts!r} must be >= 0")
+        return cls(np.zeros((n, 2)), np.zeros((n, 2)), np.zeros(n), np.zeros(n))
+
+    def copy(self) -> InterfaceState:
+        """Deep copy."""
+        return InterfaceState(self.plastic_slip.copy(), self.accumulated_slip.copy(),
+                              self.slip_path.copy(), self.dissipated.copy())
+
+    def __len__(self) -> int:
+        return self.plastic_slip.shape[0]
+
+
+class StatePair:
+    """Committed and trial history of one interface.
+
+    Args:
+        committed: the converged state; ``trial`` starts as a copy of it.
+    """
+
+    def __init__(self, committed: InterfaceState):
+        self.committed = committed
+        self.trial = committed.copy()
+
+    def update(self, trial: InterfaceState) -> None:
+        """Store the trial state returned by the latest law evaluation."""
+        if len(trial) != len(self.committed):
+            raise ValueError(
+                f"trial state has {len(trial)} points, committed has {len(self.committed)}")
+        self.trial = trial
+
+    def commit(self) -> None:
+        """Accept the trial state (after the global Newton converged)."""
+        self.committed = self.trial.copy()
+
+    def revert(self) -> None:
+        """Discard the trial state (after the global Newton failed, before the cutback)."""
+        self.trial = self.committed.copy()
