@@ -1,0 +1,255 @@
+"""Statistics of a strongly anisotropic Gaussian rough surface (paper sections 2 and 5).
+
+The surface is described by five spectral moments (Bush, Gibson & Keogh; eqs 7-18):
+``m00`` (height variance), ``m20, m02`` (mean-square slopes along / across the grain, x along
+the grain) and ``m40, m04`` (mean-square curvatures). From them follow the bandwidths (10-11),
+the summit density (17), the joint summit pdf (18), the mean summit curvature (70), the
+summit-height standard deviation (71-72), the summit mean-plane offset (73) and the plasticity
+index (69). Readings of misprinted equations follow ``EQUATIONS.md`` (see each property).
+
+Units. The whole package works in **mm, N, MPa**. At the API boundary the moments are
+accepted in the paper's micrometre convention (``unit="um"``: m00 in um^2, m20/m02
+dimensionless, m40/m04 in um^-2) or directly in mm (``unit="mm"``); they are stored in mm
+(m00 in mm^2, m40/m04 in mm^-2). Derived quantities are therefore in mm (sigma, delta),
+mm^-1 (curvatures) and mm^-2 (summit density). Moduli are in MPa.
+
+Spectral-moment convention (for :func:`moments_from_height_map`). With the PSD
+``Phi(kx, ky)`` over *angular* wavenumbers (rad/length), normalised so that
+``m00 = <z^2> = integral Phi dkx dky``, the moments are
+``m_pq = integral Phi kx^p ky^q dkx dky`` (Appendix A), hence
+``m20 = <(dz/dx)^2>``, ``m02 = <(dz/dy)^2>``, ``m40 = <(d2z/dx2)^2>``,
+``m04 = <(d2z/dy2)^2>``. If the PSD is written over *cyclic* frequencies f = k/(2 pi)
+(cycles/length), the same moments are ``(2 pi)^(p+q) integral Phi_f fx^p fy^q dfx dfy``.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+__all__ = ["SpectralMoments", "moments_from_height_map", "psum", "plasticity_index"]
+
+_UNIT_SCALE = {"um": 1.0e-3, "mm": 1.0, "m": 1.0e3}  # length unit -> mm
+
+
+def _check_positive(name: str, value: float) -> float:
+    value = float(value)
+    if not math.isfinite(value) or value <= 0.0:
+        raise ValueError(f"{name} = {value!r} is invalid: it must be finite and > 0")
+    return value
+
+
+@dataclass(frozen=True)
+class SpectralMoments:
+    """Spectral moments of a strongly anisotropic rough surface, x along the grain.
+
+    Args:
+        m00: height variance [unit^2].
+        m20: mean-square slope along x (grain) [-].
+        m02: mean-square slope along y [-].
+        m40: mean-square curvature along x [unit^-2].
+        m04: mean-square curvature along y [unit^-2].
+        unit: length unit of the given moments: "um" (paper convention, default), "mm" or "m".
+
+    The stored attributes ``m00 ... m04`` are in mm units (m00 mm^2, m40/m04 mm^-2).
+    Raises ValueError for non-positive/non-finite moments, an unknown unit, or moments whose
+    covariance matrix (8) is not positive definite (mu = 1 - beta1 - beta2 <= 0).
+    """
+
+    m00: float
+    m20: float
+    m02: float
+    m40: float
+    m04: float
+    unit: str = "um"
+    # derived, filled in __post_init__
+    alpha1: float = field(init=False, repr=False)
+    alpha2: float = field(init=False, repr=False)
+
+    def __post_init__(self):
+        if self.unit not in _UNIT_SCALE:
+            raise ValueError(f"unit = {self.unit!r} is invalid: valid units are {sorted(_UNIT_SCALE)}")
+        L = _UNIT_SCALE[self.unit]
+        vals = {n: _check_positive(n, getattr(self, n)) for n in ("m00", "m20", "m02", "m40", "m04")}
+        object.__setattr__(self, "m00", vals["m00"] * L**2)
+        object.__setattr__(self, "m20", vals["m20"])
+        object.__setattr__(self, "m02", vals["m02"])
+        object.__setattr__(self, "m40", vals["m40"] / L**2)
+        object.__setattr__(self, "m04", vals["m04"] / L**2)
+        object.__setattr__(self, "unit", "mm")
+        object.__setattr__(self, "alpha1", self.m00 * self.m40 / self.m20**2)
+        object.__setattr__(self, "alpha2", self.m00 * self.m04 / self.m02**2)
+        mu = 1.0 - 1.0 / self.alpha1 - 1.0 / self.alpha2
+        if not mu > 0.0:
+            raise ValueError(
+                f"mu = 1 - 1/alpha1 - 1/alpha2 = {mu:.6g} (alpha1 = {self.alpha1:.6g}, "
+                f"alpha2 = {self.alpha2:.6g}) is invalid: the covariance (8) requires mu in (0, 1)")
+
+    # -- bandwidths (10)-(11) -------------------------------------------------------------
+    @property
+    def beta1(self) -> float:
+        """1/alpha1 = m20^2/(m00 m40) [-], eq (11)."""
+        return 1.0 / self.alpha1
+
+    @property
+    def beta2(self) -> float:
+        """1/alpha2 = m02^2/(m00 m04) [-], eq (11)."""
+        return 1.0 / self.alpha2
+
+    @property
+    def mu(self) -> float:
+        """mu = 1 - beta1 - beta2 in (0, 1), eq (10)."""
+        return 1.0 - self.beta1 - self.beta2
+
+    @property
+    def rq(self) -> float:
+        """RMS height sqrt(m00) [mm]."""
+        return math.sqrt(self.m00)
+
+    @property
+    def summit_density(self) -> float:
+        """Dsum = (1/(2 pi)^2) sqrt(m40 m04/(m20 m02)) [mm^-2], eq (17) (exponent 1/2)."""
+        return math.sqrt(self.m40 * self.m04 / (self.m20 * self.m02)) / (2.0 * math.pi) ** 2
+
+    Dsum = summit_density
+
+    @property
+    def mean_summit_curvature(self) -> float:
+        """kappa_m bar = sqrt(pi/8) (sqrt(m04) + sqrt(m40)) [mm^-1], eq (70)."""
+        return math.sqrt(math.pi / 8.0) * (math.sqrt(self.m04) + math.sqrt(self.m40))
+
+    kappa_m = mean_summit_curvature
+
+    @property
+    def sigma_c(self) -> float:
+        """c = sigma^2/m00 = 1 - (pi/2 - 1)(beta1 + beta2) [-] (corrected reading of (71-72))."""
+        return 1.0 - (math.pi / 2.0 - 1.0) * (self.beta1 + self.beta2)
+
+    @property
+    def summit_sigma(self) -> float:
+        """Standard deviation of summit heights sigma = sqrt(c m00) [mm], eqs (71)-(72)."""
+        return math.sqrt(self.sigma_c * self.m00)
+
+    sigma = summit_sigma
+
+    @property
+    def delta(self) -> float:
+        """Summit mean plane above the surface mean plane, sqrt(pi m00/2)(sqrt b1 + sqrt b2) [mm] (73)."""
+        return math.sqrt(math.pi * self.m00 / 2.0) * (math.sqrt(self.beta1) + math.sqrt(self.beta2))
+
+    def separation(self, s):
+        """Dimensional separation h = s sqrt(m00) [mm] from s = h/sqrt(m00), eq (23)."""
+        return np.asarray(s, dtype=float) * self.rq
+
+    def plasticity_index(self, E_star: float, H: float) -> float:
+        """psi = sqrt(sigma kappa_m) E*/H [-], eq (69); E*, H in MPa."""
+        return plasticity_index(self, E_star, H)
+
+    def hardness_for_plasticity_index(self, E_star: float, psi: float) -> float:
+        """Hardness H [MPa] giving plasticity index psi for this surface and E* (inverse of (69))."""
+        E_star = _check_positive("E_star", E_star)
+        psi = _check_positive("psi", psi)
+        return math.sqrt(self.summit_sigma * self.mean_summit_curvature) * E_star / psi
+
+    def psum(self, w1, w4, w6):
+        """Joint summit pdf (18) in the normalised variables (13); see :func:`psum`."""
+        return psum(w1, w4, w6, self.beta1, self.beta2)
+
+    def as_um(self) -> dict:
+        """The moments in the paper's micrometre convention (dict)."""
+        return {"m00": self.m00 * 1e6, "m20": self.m20, "m02": self.m02,
+                "m40": self.m40 * 1e-6, "m04": self.m04 * 1e-6}
+
+
+def plasticity_index(surface: SpectralMoments, E_star: float, H: float) -> float:
+    """Plasticity index psi = sqrt(sigma kappa_m) E*/H, eq (69).
+
+    Args:
+        surface: the surface statistics.
+        E_star: effective modulus (42) [MPa].
+        H: hardness [MPa].
+    """
+    E_star = _check_positive("E_star", E_star)
+    H = _check_positive("H", H)
+    return math.sqrt(surface.summit_sigma * surface.mean_summit_curvature) * E_star / H
+
+
+def psum(w1, w4, w6, beta1: float, beta2: float):
+    """Joint pdf of summit height and curvatures, eq (18) as read in EQUATIONS.md.
+
+    psum = mu^2/sqrt(2 pi) w4 w6 exp(-X/2),
+    X = (w1 - sqrt(beta1) w4 - sqrt(beta2) w6)^2 + mu (w4^2 + w6^2),
+    on w1 in R, w4 > 0, w6 > 0 (zero elsewhere); it integrates to 1.
+
+    Args:
+        w1, w4, w6: normalised height and curvatures (13), broadcastable arrays [-].
+        beta1, beta2: inverse bandwidths (11) [-].
+    Returns:
+        density, broadcast shape [-].
+    """
+    mu = 1.0 - beta1 - beta2
+    if not mu > 0:
+        raise ValueError(f"mu = 1 - beta1 - beta2 = {mu!r} is invalid: it must be in (0, 1)")
+    w1, w4, w6 = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (w1, w4, w6)))
+    X = (w1 - math.sqrt(beta1) * w4 - math.sqrt(beta2) * w6) ** 2 + mu * (w4**2 + w6**2)
+    out = mu**2 / math.sqrt(2 * math.pi) * w4 * w6 * np.exp(-0.5 * X)
+    return np.where((w4 > 0) & (w6 > 0), out, 0.0)
+
+
+def moments_from_height_map(z, dx: float, dy: float | None = None, method: str = "fft",
+                            unit: str = "um") -> SpectralMoments:
+    """Spectral moments m00, m20, m02, m40, m04 of a sampled, periodic height map.
+
+    The map is treated as one period of a statistically homogeneous surface; its mean is
+    removed. Convention (see the module docstring): angular wavenumbers, so that
+    m20 = <(dz/dx)^2>, m40 = <(d2z/dx2)^2> etc.; with cyclic frequencies each moment would
+    carry a factor (2 pi)^(p+q).
+
+    Args:
+        z: heights, shape (nx, ny) with axis 0 along x (the grain) [unit].
+        dx: sampling step along axis 0 [unit].
+        dy: sampling step along axis 1 [unit]; defaults to dx.
+        method: "fft" (spectral derivatives: exact for band-limited periodic maps) or
+            "fd" (second-order central differences, periodic wrap; biased low for content
+            near the Nyquist frequency, like a profilometer's finite sampling interval).
+        unit: length unit of z, dx, dy ("um", "mm" or "m").
+    Returns:
+        SpectralMoments (internally in mm).
+    Raises:
+        ValueError: for a non-2D or non-finite map, non-positive steps or unknown method.
+    """
+    z = np.asarray(z, dtype=float)
+    if z.ndim != 2 or min(z.shape) < 3:
+        raise ValueError(f"z.shape = {z.shape} is invalid: a 2D map of at least 3x3 samples is needed")
+    if not np.all(np.isfinite(z)):
+        raise ValueError("z contains NaN/inf values: all heights must be finite")
+    dx = _check_positive("dx", dx)
+    dy = dx if dy is None else _check_positive("dy", dy)
+    z = z - z.mean()
+    nx, ny = z.shape
+    if method == "fft":
+        Z = np.fft.fft2(z)
+        kx = 2 * np.pi * np.fft.fftfreq(nx, d=dx)[:, None]
+        ky = 2 * np.pi * np.fft.fftfreq(ny, d=dy)[None, :]
+        if nx % 2 == 0:  # Nyquist column: derivative of a real signal there is ambiguous
+            kx = kx.copy(); kx[nx // 2] = 0.0
+        if ny % 2 == 0:
+            ky = ky.copy(); ky[:, ny // 2] = 0.0
+        P = np.abs(Z) ** 2 / (nx * ny) ** 2  # Parseval: sum P = <z^2>
+        m00 = P.sum()
+        m20 = (P * kx**2).sum()
+        m02 = (P * ky**2).sum()
+        m40 = (P * kx**4).sum()
+        m04 = (P * ky**4).sum()
+    elif method == "fd":
+        zx = (np.roll(z, -1, 0) - np.roll(z, 1, 0)) / (2 * dx)
+        zy = (np.roll(z, -1, 1) - np.roll(z, 1, 1)) / (2 * dy)
+        zxx = (np.roll(z, -1, 0) - 2 * z + np.roll(z, 1, 0)) / dx**2
+        zyy = (np.roll(z, -1, 1) - 2 * z + np.roll(z, 1, 1)) / dy**2
+        m00 = np.mean(z**2)
+        m20, m02 = np.mean(zx**2), np.mean(zy**2)
+        m40, m04 = np.mean(zxx**2), np.mean(zyy**2)
+    else:
+        raise ValueError(f"method = {method!r} is invalid: valid methods are 'fft' and 'fd'")
+    return SpectralMoments(m00, m20, m02, m40, m04, unit=unit)
