@@ -1,0 +1,122 @@
+"""Penalty laws: tangents against central finite differences, limits, purity, bad input."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from rough_contact.interface.penalty import LinearPenalty, PenaltyState, SoftplusPenalty
+
+
+def fd_tangent(law, jump, committed, h=1e-7):
+    n = jump.shape[0]
+    D = np.zeros((n, 3, 3))
+    for j in range(3):
+        e = np.zeros(3)
+        e[j] = h
+        tp = law.evaluate(jump + e, committed).traction
+        tm = law.evaluate(jump - e, committed).traction
+        D[:, :, j] = (tp - tm) / (2 * h)
+    return D
+
+
+def check_contract(res, n):
+    assert res.traction.shape == (n, 3)
+    assert res.tangent.shape == (n, 3, 3)
+    assert res.dissipation.shape == (n,)
+    assert res.area_fraction.shape == (n,)
+    assert res.contact.shape == (n,) and res.contact.dtype == bool
+    assert res.slipping.shape == (n,) and res.slipping.dtype == bool
+    assert len(res.state) == n
+
+
+@pytest.mark.parametrize("unilateral", [False, True])
+def test_linear_penalty_tangent_and_values(unilateral):
+    rng = np.random.default_rng(0)
+    law = LinearPenalty(k_normal=1e3, k_tangential=2e2, unilateral=unilateral)
+    jump = rng.uniform(-1e-2, 1e-2, (50, 3))
+    jump[np.abs(jump[:, 0]) < 1e-5, 0] = 1e-3  # keep away from the kink at g = 0
+    st = law.initial_state(50)
+    res = law.evaluate(jump, st)
+    check_contract(res, 50)
+    np.testing.assert_allclose(res.tangent, fd_tangent(law, jump, st), rtol=1e-6, atol=1e-6)
+    closed = jump[:, 0] < 0
+    np.testing.assert_allclose(res.traction[closed, 0], 1e3 * jump[closed, 0])
+    if unilateral:
+        assert np.all(res.traction[~closed] == 0.0)
+    else:
+        np.testing.assert_allclose(res.traction[~closed, 0], 1e3 * jump[~closed, 0])
+    np.testing.assert_array_equal(res.contact, closed)
+    assert np.all(np.diagonal(res.tangent, axis1=1, axis2=2) >= 0)
+
+
+def test_softplus_normal_limits():
+    law = SoftplusPenalty(k_normal=1e4, width=1e-4)
+    p, k = law.normal(np.array([-1e-2, 0.0, 1e-2]))
+    # deep contact: linear penalty p = -k g (up to w ln 2 < 1e-30 relative error here)
+    np.testing.assert_allclose(p[0], 1e4 * 1e-2, rtol=1e-12)
+    np.testing.assert_allclose(k[0], 1e4, rtol=1e-12)
+    np.testing.assert_allclose(p[1], 1e4 * 1e-4 * np.log(2.0), rtol=1e-14)
+    np.testing.assert_allclose(k[1], 0.5e4, rtol=1e-14)
+    assert p[2] < 1e-35 and k[2] < 1e-35
+
+
+@pytest.mark.parametrize("slip", [False, True])
+def test_softplus_friction_tangent_fd(slip):
+    rng = np.random.default_rng(1)
+    n = 40
+    law = SoftplusPenalty(k_normal=1e4, width=1e-3, k_tangential=5e3, friction=0.3)
+    jump = np.column_stack(
+        [rng.uniform(-3e-3, 1e-3, n), rng.uniform(-1, 1, (n, 2)) * (1e-3 if slip else 1e-6)]
+    )
+    committed = PenaltyState(rng.uniform(-1, 1, (n, 2)) * 1e-7)
+    res = law.evaluate(jump, committed)
+    check_contract(res, n)
+    if slip:
+        assert res.slipping.sum() >= n // 4
+    else:
+        assert not res.slipping.any()
+    np.testing.assert_allclose(
+        res.tangent, fd_tangent(law, jump, committed, h=1e-9), rtol=1e-5, atol=1e-3
+    )
+
+
+def test_softplus_return_map_consistency_and_purity():
+    rng = np.random.default_rng(2)
+    n = 30
+    law = SoftplusPenalty(k_normal=1e4, width=1e-3, k_tangential=5e3, friction=0.4)
+    jump = np.column_stack([rng.uniform(-3e-3, 0, n), rng.uniform(-1e-3, 1e-3, (n, 2))])
+    committed = law.initial_state(n)
+    before = committed.plastic_slip.copy()
+    res = law.evaluate(jump, committed)
+    np.testing.assert_array_equal(committed.plastic_slip, before)  # committed untouched
+    p = -res.traction[:, 0]
+    s = res.slipping
+    assert s.any()
+    # on slip the traction lies on the Coulomb cone; elsewhere inside it
+    np.testing.assert_allclose(np.linalg.norm(res.traction[s, 1:], axis=1), 0.4 * p[s], rtol=1e-12)
+    assert np.all(np.linalg.norm(res.traction[~s, 1:], axis=1) <= 0.4 * p[~s] * (1 + 1e-12))
+    # elastic part of the slip carries the traction: t_T = k_T (s - s_p)
+    np.testing.assert_allclose(
+        res.traction[:, 1:], 5e3 * (jump[:, 1:] - res.state.plastic_slip), rtol=1e-10, atol=1e-12
+    )
+    assert np.all(res.dissipation >= 0) and np.all(res.dissipation[s] > 0)
+    # re-evaluating from the trial state at the same jump is elastic (nothing more slips)
+    again = law.evaluate(jump, res.state)
+    assert not again.slipping.any()
+    assert np.all(again.dissipation == 0.0)
+    np.testing.assert_allclose(again.traction, res.traction, rtol=1e-10, atol=1e-12)
+
+
+def test_bad_input():
+    with pytest.raises(ValueError, match="k_normal"):
+        LinearPenalty(k_normal=-1.0)
+    with pytest.raises(ValueError, match="width"):
+        SoftplusPenalty(k_normal=1.0, width=0.0)
+    with pytest.raises(ValueError, match="friction"):
+        SoftplusPenalty(k_normal=1.0, width=1.0, friction=np.nan)
+    law = LinearPenalty(k_normal=1.0)
+    with pytest.raises(ValueError, match="shape"):
+        law.evaluate(np.zeros((3, 2)), law.initial_state(3))
+    with pytest.raises(ValueError, match="not finite"):
+        law.evaluate(np.array([[np.nan, 0, 0]]), law.initial_state(1))
