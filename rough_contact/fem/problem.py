@@ -1,0 +1,333 @@
+"""Bulk linear elasticity of one or more bodies plus a contact interface: residual and Jacobian.
+
+Units: mm, N, MPa (stresses and Young's moduli in MPa = N/mm^2, forces in N, tractions in MPa,
+displacements in mm, stiffness per area in MPa/mm).
+
+The discrete problem solved at load factor ``lam`` is
+
+    F(u) = K u - lam f + R_c(u) = 0,        J(u) = K + dR_c/du,
+
+with ``K`` the (linear) bulk stiffness of all bodies, ``f`` the external load vector at
+``lam = 1`` and ``R_c`` the interface residual of a
+:class:`rough_contact.fem.contact.ContactInterface` (any object with ``assemble_residual(u, b)``
+and ``assemble_jacobian(u, A)``).  The bulk part is linear, so ``K`` is assembled once, into a
+matrix whose sparsity already has room for the interface blocks (DESIGN.md section 4); every
+Jacobian is a copy of ``K`` with the same pattern plus the interface values.
+
+Dirichlet conditions are imposed on rows and columns of ``K`` (diagonal 1); their prescribed
+values enter the residual through a lifting vector computed once, and the iterate is kept equal
+to them (``F = x - g`` on those rows), so the Newton update there is zero.
+"""
+
+from __future__ import annotations
+
+import contextlib
+from dataclasses import dataclass
+from typing import Optional, Sequence
+
+import numpy as np
+import ufl
+from dolfinx import fem, la
+from dolfinx.fem import petsc as fem_petsc
+from mpi4py import MPI
+from petsc4py import PETSc
+
+__all__ = ["Material", "SurfaceLoad", "ContactProblem", "rigid_body_modes"]
+
+
+@dataclass(frozen=True)
+class Material:
+    """Isotropic linear elastic material.
+
+    Args:
+        E: Young's modulus [MPa].
+        nu: Poisson's ratio [-], in (-1, 0.5).
+    """
+
+    E: float
+    nu: float
+
+    def __post_init__(self):
+        if not (np.isfinite(self.E) and self.E > 0.0):
+            raise ValueError(f"Young's modulus E = {self.E!r} MPa must be finite and > 0")
+        if not (-1.0 < self.nu < 0.5):
+            raise ValueError(f"Poisson's ratio nu = {self.nu!r} must lie in (-1, 0.5)")
+
+    @property
+    def lame(self) -> tuple[float, float]:
+        """Lame parameters (lambda, mu) [MPa]."""
+        mu = self.E / (2.0 * (1.0 + self.nu))
+        lmbda = self.E * self.nu / ((1.0 + self.nu) * (1.0 - 2.0 * self.nu))
+        return lmbda, mu
+
+
+@dataclass(frozen=True)
+class SurfaceLoad:
+    """A load on a tagged boundary surface, scaled by the load factor.
+
+    Give exactly one of ``force`` (a total force spread uniformly over the surface's current
+    area) or ``traction`` (force per area).
+
+    Args:
+        tag: facet tag of the loaded surface.
+        force: total force vector (3,) at load factor 1 [N].
+        traction: traction vector (3,) at load factor 1 [MPa].
+    """
+
+    tag: int
+    force: Optional[Sequence[float]] = None
+    traction: Optional[Sequence[float]] = None
+
+    def __post_init__(self):
+        if (self.force is None) == (self.traction is None):
+            raise ValueError(
+                f"SurfaceLoad(tag={self.tag}): give exactly one of force= or traction= "
+                f"(got force={self.force!r}, traction={self.traction!r})"
+            )
+        vec = self.force if self.force is not None else self.traction
+        arr = np.asarray(vec, dtype=float)
+        if arr.shape != (3,) or not np.all(np.isfinite(arr)):
+            raise ValueError(f"SurfaceLoad(tag={self.tag}) vector {vec!r} must be 3 finite numbers")
+
+
+def rigid_body_modes(V: fem.FunctionSpace, cell_groups: Sequence[np.ndarray] = ()) -> PETSc.NullSpace:
+    """Near-nullspace of 3D elasticity for algebraic multigrid (GAMG).
+
+    Args:
+        V: vector P_k space on a 3D mesh.
+        cell_groups: optional list of local cell index arrays, one per disconnected body; the
+            six rigid modes are then built per body (6 x n_bodies vectors), which suits a mesh
+            holding bodies that touch only through the contact interface.
+
+    Returns:
+        An orthonormalised PETSc near-nullspace.
+    """
+    imap, bs = V.dofmap.index_map, V.dofmap.index_map_bs
+    x = V.tabulate_dof_coordinates()
+    n_local = imap.size_local + imap.num_ghosts
+    groups = list(cell_groups) or [None]
+    vecs = []
+    for cells in groups:
+        if cells is None:
+            blocks = np.arange(n_local, dtype=np.int32)
+        else:
+            blocks = np.unique(V.dofmap.list.array.reshape(-1, V.dofmap.dof_layout.num_dofs)[cells])
+        group_vecs = [la.create_petsc_vector(imap, bs) for _ in range(6)]
+        with contextlib.ExitStack() as stack:
+            basis = [np.asarray(stack.enter_context(v.localForm())) for v in group_vecs]
+            x0, x1, x2 = x[blocks, 0], x[blocks, 1], x[blocks, 2]
+            for i in range(3):
+                basis[i][bs * blocks + i] = 1.0
+            basis[3][bs * blocks + 0] = -x1
+            basis[3][bs * blocks + 1] = x0
+            basis[4][bs * blocks + 0] = x2
+            basis[4][bs * blocks + 2] = -x0
+            basis[5][bs * blocks + 2] = x1
+            basis[5][bs * blocks + 1] = -x2
+        vecs.extend(group_vecs)
+    # A rank may own no DOF of a body: its vectors are then zero locally, which is fine globally.
+    la.orthonormalize(vecs)
+    return PETSc.NullSpace().create(vectors=vecs, comm=V.mesh.comm)
+
+
+class ContactProblem:
+    """Linear elastic bodies in one mesh, coupled by a nonlinear contact interface.
+
+    Args:
+        V: vector Lagrange space (P1 or P2) on the mesh holding all bodies.
+        materials: a single :class:`Material`, or a dict ``{cell_tag: Material}`` (then
+            ``cell_tags`` is required and every tagged body gets its own E, nu).
+        bcs: Dirichlet conditions (values are held fixed; the iterate always satisfies them).
+        loads: surface loads scaled by the load factor.
+        cell_tags: cell MeshTags (needed for per-body materials and per-body rigid modes).
+        facet_tags: facet MeshTags (needed for surface loads and seating stiffness).
+        interface: the contact interface (``assemble_residual``, ``assemble_jacobian``,
+            optionally ``create_matrix``); ``None`` gives a pure bulk problem.
+        seating_tag: facet tag of a contact surface on which a small spring to ground of
+            stiffness ``seating_stiffness`` [MPa/mm] is added to the JACOBIAN ONLY while no
+            interface point is in contact (a body held only by contact has a singular first
+            Jacobian at zero pressure; the residual is untouched so converged answers are not
+            changed).
+        seating_stiffness: see ``seating_tag`` [MPa/mm].
+        quadrature_degree: optional quadrature degree for the bulk forms.
+    """
+
+    def __init__(
+        self,
+        V: fem.FunctionSpace,
+        materials,
+        bcs: Sequence[fem.DirichletBCMetaClass] = (),
+        loads: Sequence[SurfaceLoad] = (),
+        cell_tags=None,
+        facet_tags=None,
+        interface=None,
+        seating_tag: Optional[int] = None,
+        seating_stiffness: float = 0.0,
+        quadrature_degree: Optional[int] = None,
+    ):
+        msh = V.mesh
+        self.V, self.mesh, self.comm = V, msh, msh.comm
+        self.bcs = list(bcs)
+        self.loads = list(loads)
+        self.interface = interface
+        self.load_factor = 0.0
+        self.u = fem.Function(V, name="displacement")
+
+        if isinstance(materials, Material):
+            materials = {None: materials}
+        elif not materials:
+            raise ValueError("materials must be a Material or a non-empty {cell_tag: Material}")
+        if any(tag is not None for tag in materials) and cell_tags is None:
+            raise ValueError("per-body materials given by cell tag need cell_tags")
+        self.materials = dict(materials)
+        md = {} if quadrature_degree is None else {"quadrature_degree": quadrature_degree}
+        dx = ufl.Measure("dx", domain=msh, subdomain_data=cell_tags, metadata=md)
+        ds = ufl.Measure("ds", domain=msh, subdomain_data=facet_tags)
+
+        u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
+
+        def eps(w):
+            return ufl.sym(ufl.grad(w))
+
+        a = 0
+        for tag, mat in self.materials.items():
+            lmbda, mu = mat.lame
+            lmbda, mu = fem.Constant(msh, lmbda), fem.Constant(msh, mu)
+            sigma = 2.0 * mu * eps(u) + lmbda * ufl.tr(eps(u)) * ufl.Identity(3)
+            a += ufl.inner(sigma, eps(v)) * (dx if tag is None else dx(tag))
+        self.a = fem.form(a)
+
+        # External load vector at lam = 1; tractions from total forces use the surface area.
+        self.applied_force = np.zeros(3)
+        L = 0
+        for load in self.loads:
+            if facet_tags is None:
+                raise ValueError("surface loads need facet_tags")
+            area = self.comm.allreduce(
+                fem.assemble_scalar(fem.form(fem.Constant(msh, 1.0) * ds(load.tag))), op=MPI.SUM
+            )
+            if area <= 0.0:
+                raise ValueError(f"surface load tag {load.tag}: tagged area is {area} mm^2, must be > 0")
+            if load.force is not None:
+                t = np.asarray(load.force, dtype=float) / area
+            else:
+                t = np.asarray(load.traction, dtype=float)
+            self.applied_force += t * area
+            L += ufl.inner(fem.Constant(msh, t), v) * ds(load.tag)
+        if L == 0:
+            L = ufl.inner(fem.Constant(msh, np.zeros(3)), v) * ufl.dx(domain=msh)
+        self.L = fem.form(L)
+
+        # Bulk stiffness, once, into a matrix with room for the interface blocks.
+        t0 = MPI.Wtime()
+        if interface is not None and hasattr(interface, "create_matrix"):
+            self.K = interface.create_matrix(self.a)
+        else:
+            self.K = fem_petsc.create_matrix(self.a)
+        self.K.zeroEntries()
+        fem_petsc.assemble_matrix(self.K, self.a, bcs=self.bcs)
+        self.K.assemble()
+        self.A = self.K.duplicate(copy=False)
+        self.setup_time = MPI.Wtime() - t0  # [s] pattern + bulk stiffness assembly
+
+        self.f = fem_petsc.assemble_vector(self.L)
+        self.f.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        fem_petsc.set_bc(self.f, self.bcs, scale=0.0)
+        # lift = K_full[:, bc] g: the coupling of prescribed values into the free rows.
+        self.lift = self.f.duplicate()
+        self.lift.set(0.0)
+        fem_petsc.apply_lifting(self.lift, [self.a], bcs=[self.bcs], scale=-1.0)
+        self.lift.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        fem_petsc.set_bc(self.lift, self.bcs, scale=0.0)
+        self.f_norm = self.f.norm()
+
+        self.seating_stiffness = float(seating_stiffness)
+        if self.seating_stiffness < 0.0 or not np.isfinite(self.seating_stiffness):
+            raise ValueError(f"seating_stiffness = {seating_stiffness} MPa/mm must be finite and >= 0")
+        self.M_seat = None
+        if seating_tag is not None and self.seating_stiffness > 0.0:
+            m = fem.form(fem.Constant(msh, self.seating_stiffness) * ufl.inner(u, v) * ds(seating_tag))
+            # On the pattern of K (a superset), so it can be added with SAME_NONZERO_PATTERN.
+            self.M_seat = self.K.duplicate(copy=False)
+            self.M_seat.zeroEntries()
+            fem_petsc.assemble_matrix(self.M_seat, m, bcs=self.bcs, diagonal=0.0)
+            self.M_seat.assemble()
+        self.seating_active = False
+
+        # Initial iterate satisfies the Dirichlet values.
+        fem.set_bc(self.u.x.array, self.bcs)
+        self.u.x.scatter_forward()
+        self.b = self.f.duplicate()
+        self.counters = {"residual": 0, "jacobian": 0}
+        self.timings = {"bulk": 0.0, "interface_residual": 0.0, "interface_jacobian": 0.0}
+
+    # ------------------------------------------------------------------ PETSc callbacks
+    def update_solution(self, x: PETSc.Vec) -> None:
+        """Copy the SNES iterate ``x`` into ``self.u`` (with ghost values)."""
+        x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+        x.copy(self.u.vector)
+        self.u.x.scatter_forward()
+
+    def F(self, snes, x: PETSc.Vec, b: PETSc.Vec) -> None:
+        """Residual ``b = K x - lam f + lift + R_c(x)``, with ``b = x - g`` on Dirichlet rows."""
+        self.update_solution(x)
+        t0 = MPI.Wtime()
+        self.K.mult(x, b)
+        b.axpy(-self.load_factor, self.f)
+        b.axpy(1.0, self.lift)
+        t1 = MPI.Wtime()
+        if self.interface is not None:
+            self.interface.assemble_residual(self.u, b)
+        t2 = MPI.Wtime()
+        fem_petsc.set_bc(b, self.bcs, x, -1.0)
+        self.timings["bulk"] += t1 - t0
+        self.timings["interface_residual"] += t2 - t1
+        self.counters["residual"] += 1
+
+    def J(self, snes, x: PETSc.Vec, A: PETSc.Mat, P: PETSc.Mat) -> None:
+        """Consistent Jacobian ``K + dR_c/du`` (plus the seating spring while nothing touches)."""
+        self.update_solution(x)
+        t0 = MPI.Wtime()
+        self.K.copy(A, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+        t1 = MPI.Wtime()
+        if self.interface is not None:
+            self.interface.assemble_jacobian(self.u, A)
+        A.assemble()
+        t2 = MPI.Wtime()
+        self.seating_active = False
+        if self.M_seat is not None and self.n_in_contact() == 0:
+            A.axpy(1.0, self.M_seat, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+            self.seating_active = True
+        self.timings["bulk"] += t1 - t0
+        self.timings["interface_jacobian"] += t2 - t1
+        self.counters["jacobian"] += 1
+        if P is not A:
+            P.assemble()
+
+    # ------------------------------------------------------------------ helpers
+    def n_in_contact(self) -> int:
+        """Global number of interface points in contact at the last evaluation."""
+        ci = self.interface
+        if ci is None:
+            return 0
+        if hasattr(ci, "slip_stats"):
+            return int(ci.slip_stats().n_contact)
+        return 1  # unknown: assume contact, never add the seating spring
+
+    def set_load_factor(self, lam: float) -> None:
+        """Set the load factor ``lam`` (external loads are ``lam`` times their nominal value)."""
+        if not np.isfinite(lam):
+            raise ValueError(f"load factor = {lam!r} must be finite")
+        self.load_factor = float(lam)
+
+    def reset_timings(self) -> None:
+        for k in self.timings:
+            self.timings[k] = 0.0
+        for k in self.counters:
+            self.counters[k] = 0
+
+    @property
+    def num_dofs(self) -> int:
+        """Global number of displacement DOFs."""
+        imap = self.V.dofmap.index_map
+        return imap.size_global * self.V.dofmap.index_map_bs

@@ -1,0 +1,255 @@
+"""Incremental loading with commit / revert and automatic cutback.
+
+Units: load factors are dimensionless (external loads = factor x nominal loads); forces in N,
+dissipation in N mm (= mJ).
+
+:func:`load_path` is a generator: it yields an :class:`Increment` after every converged step
+(including the intermediate steps of a cutback), after the interface history has been committed,
+so a caller can write output and stop at any time with every converged increment kept::
+
+    for inc in load_path(problem, solver, load_unload_factors(16)):
+        writer.write(inc)
+
+A step that fails (SNES diverged, a non-finite residual, or a law raising ``ValueError``,
+``ArithmeticError`` or ``RuntimeError`` such as a local return-map failure) is reverted
+(displacement and interface history back to the last committed state) and retried with half the increment, down to ``min_increment``; then a
+:class:`LoadStepError` names the load factor that could not be reached.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Iterable, Iterator, Optional
+
+import numpy as np
+from mpi4py import MPI
+from petsc4py import PETSc
+
+__all__ = ["Increment", "LoadStepError", "load_path", "load_unload_factors", "interface_summary"]
+
+
+class LoadStepError(RuntimeError):
+    """Raised when a load step cannot converge even with the minimum increment.
+
+    Attributes:
+        load_factor: the load factor that could not be reached.
+        last_converged: the last converged load factor (its state is committed).
+    """
+
+    def __init__(self, message: str, load_factor: float, last_converged: float):
+        super().__init__(message)
+        self.load_factor = load_factor
+        self.last_converged = last_converged
+
+
+@dataclass
+class Increment:
+    """Summary of one converged load step (global figures, identical on every rank).
+
+    Attributes:
+        step: 1-based count of converged steps.
+        load_factor: load factor reached [-].
+        target: the load factor of the load path this step heads for [-].
+        iterations: Newton iterations.
+        residual: final residual norm [N].
+        residuals: residual norm history of the Newton iterations [N].
+        n_points: interface quadrature points (0 without interface).
+        n_active: points in contact (p > 0).
+        n_slipping: points slipping.
+        applied_force: total external force vector at this load factor (3,) [N].
+        contact_force: total interface force on the FIRST body (3,) [N] (zeros if unknown).
+        real_area: real contact area [mm^2] (nan if unknown).
+        dissipation: cumulative frictional dissipation [N mm] (nan if unknown).
+        cutbacks: halvings done before this step converged.
+        wall_time: seconds spent on this step (including failed attempts).
+        linear_solver: KSP+PC used.
+    """
+
+    step: int
+    load_factor: float
+    target: float
+    iterations: int
+    residual: float
+    residuals: list = field(default_factory=list)
+    n_points: int = 0
+    n_active: int = 0
+    n_slipping: int = 0
+    applied_force: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    contact_force: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    real_area: float = float("nan")
+    dissipation: float = float("nan")
+    cutbacks: int = 0
+    wall_time: float = 0.0
+    linear_solver: str = ""
+
+
+def load_unload_factors(n_load: int, n_unload: Optional[int] = None,
+                        final_factor: Optional[float] = None) -> list:
+    """Load factors 1/n, 2/n, ..., 1 then back down in ``n_unload`` equal steps.
+
+    Args:
+        n_load: number of loading increments (>= 1).
+        n_unload: number of unloading increments (default ``n_load - 1``; 0 = no unloading).
+        final_factor: load factor at the end of unloading (default ``1/n_load``: a body held
+            only by contact cannot be unloaded to exactly zero force).
+
+    Returns:
+        List of load factors.
+    """
+    if int(n_load) != n_load or n_load < 1:
+        raise ValueError(f"n_load = {n_load!r} must be an integer >= 1")
+    up = [(i + 1) / n_load for i in range(n_load)]
+    if n_unload is None:
+        n_unload = n_load - 1
+    if int(n_unload) != n_unload or n_unload < 0:
+        raise ValueError(f"n_unload = {n_unload!r} must be an integer >= 0")
+    final = 1.0 / n_load if final_factor is None else float(final_factor)
+    if not (0.0 <= final < 1.0):
+        raise ValueError(f"final_factor = {final_factor!r} must lie in [0, 1)")
+    down = [1.0 - (1.0 - final) * (i + 1) / n_unload for i in range(n_unload)]
+    return up + down
+
+
+def interface_summary(interface, comm: MPI.Comm) -> dict:
+    """Global interface figures after the last evaluation (robust to missing methods)."""
+    out = {"n_points": 0, "n_active": 0, "n_slipping": 0, "contact_force": np.zeros(3),
+           "real_area": float("nan"), "dissipation": float("nan")}
+    if interface is None:
+        return out
+
+    def get(name):
+        val = getattr(interface, name, None)
+        return val() if callable(val) else val
+
+    if hasattr(interface, "slip_stats"):
+        stats = interface.slip_stats()
+        out["n_points"] = int(stats.n_points)
+        out["n_active"] = int(stats.n_contact)
+        out["n_slipping"] = int(stats.n_slipping)
+    val = get("contact_force")
+    if val is not None:
+        out["contact_force"] = np.asarray(val, dtype=float).reshape(-1)
+    val = get("real_contact_area")
+    if val is not None:
+        out["real_area"] = float(val)
+    val = get("dissipation")
+    if val is not None:
+        out["dissipation"] = float(val)
+    return out
+
+
+def _print_increment(inc: Increment) -> None:
+    f = inc.contact_force
+    PETSc.Sys.Print(
+        f"  step {inc.step:3d}  load {inc.load_factor:8.5f}  Newton {inc.iterations:2d}  "
+        f"|F| {inc.residual:9.3e}  active {inc.n_active:6d}/{inc.n_points:<6d} "
+        f"slip {inc.n_slipping:6d}  contact force ({f[0]: .4g}, {f[1]: .4g}, {f[2]: .4g}) N"
+        + (f"  cutbacks {inc.cutbacks}" if inc.cutbacks else "")
+        + f"  [{inc.wall_time:.2f} s]"
+    )
+
+
+def load_path(problem, solver, factors: Iterable[float], *, min_increment: float = 1e-4,
+              max_growth: float = 2.0, verbose: bool = True) -> Iterator[Increment]:
+    """Follow ``factors`` with Newton solves; yield after each converged, committed step.
+
+    Args:
+        problem: :class:`~rough_contact.fem.problem.ContactProblem` (its ``u`` and interface
+            carry the state; they start from the currently committed state).
+        solver: :class:`~rough_contact.solver.snes.SNESSolver` of ``problem``.
+        factors: load factors to reach in order (loading and unloading alike).
+        min_increment: smallest load-factor increment tried in a cutback (> 0).
+        max_growth: after a cutback, a converged sub-step lets the next one grow by this
+            factor (>= 1) until the target is reached.
+        verbose: print one line per converged step with ``PETSc.Sys.Print``.
+
+    Yields:
+        :class:`Increment` per converged step.
+
+    Raises:
+        LoadStepError: a step failed with an increment below ``min_increment``.
+    """
+    if not (min_increment > 0.0 and np.isfinite(min_increment)):
+        raise ValueError(f"min_increment = {min_increment!r} must be finite and > 0")
+    if not (max_growth >= 1.0):
+        raise ValueError(f"max_growth = {max_growth!r} must be >= 1")
+    comm = problem.comm
+    interface = problem.interface
+    u_committed = problem.u.vector.copy()
+    lam_committed = problem.load_factor
+    step = 0
+    for target in factors:
+        target = float(target)
+        if not np.isfinite(target):
+            raise ValueError(f"load factor {target!r} in the load path must be finite")
+        delta = target - lam_committed
+        cutbacks = 0
+        t_start = time.perf_counter()
+        while True:
+            if abs(target - lam_committed) <= 1e-14 * max(1.0, abs(target)):
+                break
+            if abs(delta) > abs(target - lam_committed):
+                delta = target - lam_committed
+            lam = lam_committed + delta
+            problem.set_load_factor(lam)
+            ok, result, err = _attempt(solver, comm)
+            if ok:
+                # Re-evaluate at the converged iterate so the trial history matches it.
+                problem.F(None, solver.x, problem.b)
+                if interface is not None:
+                    interface.commit()
+                problem.u.vector.copy(u_committed)
+                lam_committed = lam
+                step += 1
+                summary = interface_summary(interface, comm)
+                inc = Increment(
+                    step=step, load_factor=lam, target=target, iterations=result.iterations,
+                    residual=result.residuals[-1] if result.residuals else float("nan"),
+                    residuals=list(result.residuals), applied_force=lam * problem.applied_force,
+                    cutbacks=cutbacks, wall_time=time.perf_counter() - t_start,
+                    linear_solver=solver.linear_solver, **summary)
+                if verbose:
+                    _print_increment(inc)
+                yield inc
+                t_start = time.perf_counter()
+                if cutbacks:
+                    delta *= max_growth
+                continue
+            # Failure: revert to the committed state and halve the increment.
+            u_committed.copy(problem.u.vector)
+            problem.u.x.scatter_forward()
+            problem.set_load_factor(lam_committed)
+            if interface is not None:
+                interface.revert()
+            why = err if err else f"{result.reason_name} after {result.iterations} its"
+            delta *= 0.5
+            cutbacks += 1
+            if abs(delta) < min_increment:
+                raise LoadStepError(
+                    f"load step to load factor {lam:.6g} (target {target:.6g}) failed ({why}); "
+                    f"cutback below the minimum increment {min_increment:g}; last converged load "
+                    f"factor {lam_committed:.6g} is committed", lam, lam_committed)
+            if verbose:
+                PETSc.Sys.Print(f"  load {lam:.6g} failed ({why}): cutback to increment "
+                                f"{delta:.4g}")
+
+
+def _attempt(solver, comm):
+    """One SNES solve; a law/geometry error on any rank is turned into a global failure."""
+    err = ""
+    try:
+        result = solver.solve()
+        ok = result.converged
+    except (ValueError, ArithmeticError, RuntimeError) as exc:
+        # a law error (bad input, local return-map failure) raised inside a SNES callback
+        # reaches us unchanged; a smaller increment is the remedy. The interface raises such
+        # errors on every rank together (it gathers them before any later collective).
+        result, ok, err = None, False, f"{type(exc).__name__}: {exc}"
+    # Every rank must agree (an exception on one rank only would otherwise hang the others).
+    ok_all = comm.allreduce(bool(ok), op=MPI.LAND)
+    if result is None:
+        from rough_contact.solver.snes import SolveResult
+
+        result = SolveResult(False, -1, "EXCEPTION", 0, [])
+    return ok_all, result, err

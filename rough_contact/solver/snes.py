@@ -1,0 +1,181 @@
+"""PETSc SNES (Newton with line search) for a :class:`rough_contact.fem.problem.ContactProblem`.
+
+Units follow the problem (residuals are nodal forces in N).
+
+All SNES / KSP / PC options live under ONE options prefix (default ``"rc_"``), so anything can
+be changed from the command line, e.g. ``-rc_snes_monitor -rc_pc_type gamg -rc_ksp_type cg``.
+Defaults are written into the options database only when the user has not given them:
+
+* Newton with a line search (``newtonls`` + ``bt``), relative tolerance 1e-9, absolute
+  tolerance 1e-10 times the norm of the nominal load vector, at most 50 iterations;
+* a direct LU factorisation with MUMPS below ``dof_threshold`` global DOFs;
+* above it, GMRES (the frictional tangent is not symmetric) preconditioned by GAMG with the
+  rigid-body near-nullspace of every body.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Optional
+
+import numpy as np
+from petsc4py import PETSc
+
+__all__ = ["SolveResult", "SNESSolver", "set_default_options"]
+
+
+def set_default_options(prefix: str, defaults: dict) -> None:
+    """Write ``defaults`` under ``prefix`` into the options database where absent."""
+    opts = PETSc.Options()
+    for key, value in defaults.items():
+        if not opts.hasName(prefix + key):
+            opts.setValue(prefix + key, value)
+
+
+@dataclass
+class SolveResult:
+    """Outcome of one nonlinear solve.
+
+    Attributes:
+        converged: SNES reported convergence.
+        reason: SNES converged reason (int; negative = diverged).
+        reason_name: readable name of ``reason``.
+        iterations: Newton iterations.
+        residuals: residual 2-norms, one per iteration (iteration 0 first) [N].
+        linear_iterations: total KSP iterations.
+    """
+
+    converged: bool
+    reason: int
+    reason_name: str
+    iterations: int
+    residuals: list = field(default_factory=list)
+    linear_iterations: int = 0
+
+
+def _reason_name(reason: int) -> str:
+    for name in dir(PETSc.SNES.ConvergedReason):
+        if not name.startswith("_") and getattr(PETSc.SNES.ConvergedReason, name) == reason:
+            return name
+    return str(reason)
+
+
+class SNESSolver:
+    """Newton solver on a problem exposing ``F``, ``J``, ``u``, ``A``, ``b``.
+
+    Args:
+        problem: a :class:`~rough_contact.fem.problem.ContactProblem`.
+        prefix: PETSc options prefix of the SNES (and its KSP/PC).
+        dof_threshold: global DOF count above which the default linear solver is GAMG+CG
+            instead of MUMPS LU.
+        near_nullspace: PETSc near-nullspace set on the Jacobian (for GAMG); ``None`` builds the
+            rigid body modes of ``problem.V`` when the iterative default is used.
+        defaults: extra default options (without prefix) that override the built-in ones but
+            not the command line.
+    """
+
+    def __init__(
+        self,
+        problem,
+        prefix: str = "rc_",
+        dof_threshold: int = 100_000,
+        near_nullspace: Optional[PETSc.NullSpace] = None,
+        defaults: Optional[dict] = None,
+    ):
+        if not isinstance(prefix, str) or (prefix and not prefix.endswith("_")):
+            raise ValueError(f"options prefix {prefix!r} must be a string ending with '_'")
+        if dof_threshold < 0:
+            raise ValueError(f"dof_threshold = {dof_threshold} must be >= 0")
+        self.problem = problem
+        self.prefix = prefix
+        comm = problem.comm
+        n = problem.num_dofs
+        direct = n <= dof_threshold
+        opts = {
+            "snes_type": "newtonls",
+            "snes_linesearch_type": "bt",
+            "snes_rtol": 1e-9,
+            "snes_atol": max(1e-10 * problem.f_norm, 1e-14),
+            "snes_stol": 0.0,
+            "snes_max_it": 50,
+            "snes_error_if_not_converged": False,
+        }
+        if direct:
+            opts.update({
+                "ksp_type": "preonly",
+                "pc_type": "lu",
+                "pc_factor_mat_solver_type": "mumps",
+            })
+        else:
+            opts.update({
+                # the frictional tangent is not symmetric: GMRES, not CG
+                "ksp_type": "gmres",
+                "ksp_gmres_restart": 100,
+                "ksp_rtol": 1e-10,
+                "ksp_max_it": 1000,
+                "pc_type": "gamg",
+                "pc_gamg_type": "agg",
+                "pc_gamg_agg_nsmooths": 1,
+                "pc_gamg_threshold": 0.02,
+                "mg_levels_ksp_type": "chebyshev",
+                "mg_levels_pc_type": "jacobi",
+                "mg_levels_esteig_ksp_type": "cg",
+            })
+        opts.update(defaults or {})
+        set_default_options(prefix, opts)
+
+        self.snes = PETSc.SNES().create(comm)
+        self.snes.setOptionsPrefix(prefix)
+        # Never hand u.vector to SNES: the callbacks copy x into u, and line-search work
+        # vectors would overwrite the iterate (DESIGN.md).
+        self.x = problem.u.vector.copy()
+        self.snes.setFunction(problem.F, problem.b)
+        self.snes.setJacobian(problem.J, problem.A)
+        self.snes.setFromOptions()
+        pc_type = self.snes.getKSP().getPC().getType()
+        if pc_type == "gamg" or near_nullspace is not None:
+            if near_nullspace is None:
+                from rough_contact.fem.problem import rigid_body_modes
+
+                near_nullspace = rigid_body_modes(problem.V, getattr(problem, "body_cells", ()))
+            problem.A.setNearNullSpace(near_nullspace)
+            problem.K.setNearNullSpace(near_nullspace)
+        self.near_nullspace = near_nullspace
+        self._residuals: list = []
+        self.snes.setMonitor(self._monitor)
+
+    def _monitor(self, snes, its, norm):
+        self._residuals.append(float(norm))
+
+    @property
+    def linear_solver(self) -> str:
+        ksp = self.snes.getKSP()
+        pc = ksp.getPC()
+        name = f"{ksp.getType()}+{pc.getType()}"
+        if pc.getType() == "lu":
+            name += f"({pc.getFactorSolverType()})"
+        return name
+
+    def solve(self) -> SolveResult:
+        """Solve F(u) = 0 starting from ``problem.u``; on success ``problem.u`` holds the root.
+
+        On failure ``problem.u`` holds the last iterate: the caller reverts it.
+        """
+        self._residuals = []
+        self.problem.u.vector.copy(self.x)
+        try:
+            self.snes.solve(None, self.x)
+        except PETSc.Error as err:  # e.g. a factorisation failure inside the KSP
+            PETSc.Sys.Print(f"  SNES raised PETSc error {err}")
+            return SolveResult(False, -999, "PETSC_ERROR", self.snes.getIterationNumber(),
+                               list(self._residuals), self.snes.getLinearSolveIterations())
+        reason = self.snes.getConvergedReason()
+        self.problem.update_solution(self.x)
+        res = list(self._residuals)
+        ok = reason > 0 and all(np.isfinite(res))
+        return SolveResult(ok, int(reason), _reason_name(reason), self.snes.getIterationNumber(),
+                           res, self.snes.getLinearSolveIterations())
+
+    def destroy(self) -> None:
+        self.snes.destroy()
+        self.x.destroy()

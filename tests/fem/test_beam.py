@@ -1,0 +1,119 @@
+"""Beam on a rigid base (paper section 9.1, Table 4): a tiny run of the demo's ``main()``.
+
+Serial and ``mpirun -n 2``. Checks what does not come from our own output: global force
+balance (the integrated interface force equals the applied load), the physics trend of Table 4
+(the centre deflection grows with the height variance m00), the sign pattern of Fig 13 (the
+centre approaches, the end moves less or lifts), that without friction the ends lift more, the
+rigid-beam limit (uniform deflection given by the normal law alone), and that 1 and 2 ranks
+give the same answers.
+
+Units: mm, N, MPa.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+
+import numpy as np
+import pytest
+from mpi4py import MPI
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "demos"))
+import demo_beam_rigid_base as demo  # noqa: E402
+
+TINY = dict(mesh_size=60.0, contact_size=10.0, order=1, steps=4, plot=False, xdmf=False,
+            verbose=False)
+
+
+def _outdir(comm, tmp_path_factory):
+    path = str(tmp_path_factory.mktemp("beam")) if comm.rank == 0 else None
+    return comm.bcast(path, root=0)
+
+
+@pytest.fixture(scope="module")
+def world(tmp_path_factory):
+    comm = MPI.COMM_WORLD
+    return demo.main(cases=(1, 3), outdir=_outdir(comm, tmp_path_factory), comm=comm,
+                     prefix="beamtest_", **TINY)
+
+
+def test_force_balance(world):
+    """Integrated interface force on the beam equals the applied 981 N (half model)."""
+    for r in world:
+        assert r["applied_force"][2] == pytest.approx(-demo.TOTAL_FORCE / 2.0, rel=1e-12)
+        assert abs(r["contact_force"][2] + r["applied_force"][2]) <= 1e-8 * demo.TOTAL_FORCE
+        assert r["max_force_error"] < 1e-8
+        # the x-resultant vanishes by symmetry (the y-resultant is carried by the symmetry plane)
+        assert abs(r["contact_force"][0]) <= 1e-8 * demo.TOTAL_FORCE
+
+
+def test_deflection_trends(world):
+    """Table 4 / Fig 13 trends: the centre approaches more for the rougher surface (larger
+    m00), the centre approaches (uN < 0) and the end moves less (uN_end > uN_centre)."""
+    by_case = {r["case"]: r for r in world}
+    rough, smooth = by_case[1], by_case[3]
+    assert rough["m00"] > smooth["m00"]
+    assert rough["centre"] < smooth["centre"] < 0.0
+    for r in world:
+        assert r["end"] > r["centre"]
+        # the profile runs from the centre value to the end value
+        assert r["profile"][0] == r["centre"] and r["profile"][-1] == r["end"]
+        assert np.all(np.isfinite(r["profile"]))
+
+
+def test_one_vs_two_ranks(world, tmp_path_factory):
+    """Serial run (COMM_SELF on every rank) equals the COMM_WORLD run to 1e-8 relative."""
+    comm = MPI.COMM_WORLD
+    if comm.size == 1:
+        pytest.skip("run with mpirun -n 2 to compare partitions")
+    path = os.path.join(_outdir(comm, tmp_path_factory), f"self{comm.rank}")
+    serial = demo.main(cases=(1, 3), outdir=path, comm=MPI.COMM_SELF, prefix="beamself_",
+                       **TINY)
+    for a, b in zip(world, serial):
+        scale = max(abs(a["centre"]), abs(a["end"]))
+        for key in ("centre", "end", "centre_mean", "end_mean"):
+            assert abs(a[key] - b[key]) <= 1e-8 * scale, key
+        assert np.max(np.abs(a["profile"] - b["profile"])) <= 1e-8 * scale
+        assert np.allclose(a["contact_force"], b["contact_force"], rtol=0, atol=1e-8 * 981.0)
+
+
+def test_frictionless_ends_lift_more(world, tmp_path_factory):
+    """Without friction nothing restrains the stretching of the bottom face, the beam bends
+    more and its ends move further from the base; the force balance still holds (the x
+    rigid motion is then fixed on the mid-plane)."""
+    comm = MPI.COMM_WORLD
+    free = demo.main(cases=(1,), friction="none", outdir=_outdir(comm, tmp_path_factory),
+                     comm=comm, prefix="beamfree_", **TINY)[0]
+    with_friction = next(r for r in world if r["case"] == 1)
+    assert free["end"] > with_friction["end"]
+    assert free["end"] - free["centre"] > with_friction["end"] - with_friction["centre"]
+    assert abs(free["contact_force"][2] + free["applied_force"][2]) <= 1e-8 * demo.TOTAL_FORCE
+    assert free["kt_over_kn"] is None
+
+
+def test_rigid_beam_limit(tmp_path_factory):
+    """A (nearly) rigid beam presses uniformly: uN at the centre and at the end both tend to
+    h(p_mean) - h(p_seat) of the normal law alone (p_mean = 981 N / 2500 mm^2), with an error
+    that falls like 1/E of the beam."""
+    comm = MPI.COMM_WORLD
+    errors = []
+    for factor in (1e3, 1e4):
+        r = demo.main(cases=(1,), beam_modulus=demo.E1 * factor, prefix="beamrigid_",
+                      outdir=_outdir(comm, tmp_path_factory), comm=comm, **TINY)[0]
+        law = demo.make_normal_law(MPI.COMM_SELF, 0.625, "elastic")
+        p_seat = demo.INITIAL_FORCE / 5000.0
+        p_mean = demo.TOTAL_FORCE / 5000.0
+        h = law.separation_for_pressure(np.array([p_seat, p_mean]))
+        rigid = h[1] - h[0]
+        assert r["rigid"] == pytest.approx(rigid, rel=1e-12)
+        errors.append(max(abs(r["centre"] - rigid), abs(r["end"] - rigid)) / abs(rigid))
+    assert errors[1] < 2e-3
+    assert errors[1] < 0.2 * errors[0]
+
+
+def test_bad_arguments_rejected():
+    with pytest.raises(ValueError, match="cases"):
+        demo.main(cases=(7,), comm=MPI.COMM_WORLD, **TINY)
+    with pytest.raises(ValueError, match="friction"):
+        demo.main(cases=(1,), friction="coulomb", comm=MPI.COMM_WORLD, **TINY)
