@@ -24,6 +24,7 @@ Spectral-moment convention (for :func:`moments_from_height_map`). With the PSD
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -38,6 +39,10 @@ def _check_positive(name: str, value: float) -> float:
     if not math.isfinite(value) or value <= 0.0:
         raise ValueError(f"{name} = {value!r} is invalid: it must be finite and > 0")
     return value
+
+
+# m04/m40 below which SpectralMoments warns that the strongly anisotropic model is out of range.
+ANISOTROPY_WARN_RATIO = 10.0
 
 
 @dataclass(frozen=True)
@@ -85,6 +90,16 @@ class SpectralMoments:
             raise ValueError(
                 f"mu = 1 - 1/alpha1 - 1/alpha2 = {mu:.6g} (alpha1 = {self.alpha1:.6g}, "
                 f"alpha2 = {self.alpha2:.6g}) is invalid: the covariance (8) requires mu in (0, 1)")
+        ratio = self.m04 / self.m40
+        if ratio < ANISOTROPY_WARN_RATIO:
+            # Principal summit curvatures differ by about sqrt(m04/m40): below ~3 the eccentric
+            # elliptic-paraboloid summits of the strongly anisotropic model (x = grain) are no
+            # longer a small-error idealisation. The paper's surfaces have 100 and 6561.
+            warnings.warn(
+                f"m04/m40 = {ratio:.4g} < {ANISOTROPY_WARN_RATIO:g}: the strongly anisotropic "
+                "model (Bush, Gibson & Keogh) assumes m04/m40 >> 1 with x along the grain "
+                "(paper: 100 and 6561); a nearly isotropic surface, or one with the grain along "
+                "y, is outside its validity", UserWarning, stacklevel=3)
 
     # -- bandwidths (10)-(11) -------------------------------------------------------------
     @property

@@ -508,7 +508,8 @@ class ContactInterface:
             finite = np.isfinite(res.traction).all(axis=1) & np.isfinite(res.tangent).all(
                 axis=(1, 2)
             )
-        except ValueError as exc:  # keep ranks in step: raise everywhere, below
+        except (ValueError, ArithmeticError, RuntimeError) as exc:  # keep ranks in step: raise
+            # everywhere, below (a rank-local ReturnMappingError would otherwise hang the rest)
             error, finite = str(exc), np.zeros(self.n_points, dtype=bool)
         errors = [e for e in self.comm.allgather(error) if e is not None]
         if errors:

@@ -122,6 +122,10 @@ class SNESSolver:
                 "mg_levels_esteig_ksp_type": "cg",
             })
         opts.update(defaults or {})
+        # An absolute tolerance given by the user (command line or ``defaults``) is kept as is;
+        # otherwise solve() raises it to the residual's round-off floor (tiny loads).
+        self._auto_atol = not PETSc.Options().hasName(prefix + "snes_atol") and (
+            "snes_atol" not in (defaults or {}))
         set_default_options(prefix, opts)
 
         self.snes = PETSc.SNES().create(comm)
@@ -132,6 +136,8 @@ class SNESSolver:
         self.snes.setFunction(problem.F, problem.b)
         self.snes.setJacobian(problem.J, problem.A)
         self.snes.setFromOptions()
+        self._atol0 = self.snes.getTolerances()[1]
+        self._k_norm_inf = problem.K.norm(PETSc.NormType.INFINITY)
         pc_type = self.snes.getKSP().getPC().getType()
         if pc_type == "gamg" or near_nullspace is not None:
             if near_nullspace is None:
@@ -163,6 +169,13 @@ class SNESSolver:
         """
         self._residuals = []
         self.problem.u.vector.copy(self.x)
+        if self._auto_atol:
+            # Round-off floor of F = K u - f: about eps |K|_inf |u|_inf. Below it Newton cannot
+            # converge (seen at a total load of 1 mN on the punch, tests/fem/test_extremes.py).
+            u_inf = max(self.x.norm(PETSc.NormType.INFINITY), 1e-30)
+            floor = 10.0 * np.finfo(float).eps * self._k_norm_inf * u_inf
+            rtol, atol, stol, max_it = self.snes.getTolerances()
+            self.snes.setTolerances(atol=max(self._atol0, floor))
         try:
             self.snes.solve(None, self.x)
         except PETSc.Error as err:  # e.g. a factorisation failure inside the KSP
