@@ -66,7 +66,12 @@ def parse_args(argv):
     parser.add_argument("--outdir", default="results/flat_punch")
     parser.add_argument("--dof-threshold", type=int, default=100_000,
                         help="above this many DOFs the default solver is GAMG+GMRES, else MUMPS")
-    return parser.parse_known_args(argv)
+    args, rest = parser.parse_known_args(argv)
+    # PETSc options have one dash; a double-dash leftover is a mistyped option of this script.
+    bad = [a for a in rest if a.startswith("--")]
+    if bad:
+        parser.error(f"unrecognized arguments: {' '.join(bad)}")
+    return args, rest
 
 
 import petsc4py  # noqa: E402
