@@ -182,28 +182,9 @@ def flat_punch(mesh_size: float = 10.0, contact_size: typing.Optional[float] = N
 
 def main(argv=None) -> None:
     """Build the scene, print its labels and measures, optionally write XDMF."""
-    import argparse
-    import logging
+    from rough_contact.fem.mesh import scene_cli
 
-    from rough_contact.fem.mesh import describe, write_xdmf
-
-    logging.getLogger().setLevel(logging.WARNING)
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0], allow_abbrev=False)
-    parser.add_argument("--mesh-size", type=float, default=None)
-    parser.add_argument("--contact-size", type=float, default=None)
-    parser.add_argument("--load-half-width", type=float, default=None)
-    parser.add_argument("--transition", type=float, default=None)
-    parser.add_argument("--order", type=int, default=1)
-    parser.add_argument("--cell-type", default=None, choices=["tetrahedron", "hexahedron"])
-    parser.add_argument("--xdmf", default=None, help="write mesh and tags to this file")
-    opts = parser.parse_args(argv)
-    kwargs = {k: v for k, v in vars(opts).items() if k != "xdmf" and v is not None}
-    scene = flat_punch(**kwargs)
-    text = describe(scene)
-    if scene.mesh.comm.rank == 0:
-        print(text)
-    if opts.xdmf:
-        write_xdmf(scene, opts.xdmf)
+    scene_cli(flat_punch, ['mesh_size', 'contact_size', 'load_half_width', 'transition'], argv, description=__doc__.splitlines()[0])
 
 
 if __name__ == "__main__":

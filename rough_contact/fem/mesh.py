@@ -629,3 +629,33 @@ def describe(scene: Scene) -> str:
         lines.append(f"  {name:20s} tag {tag:3d}  {kind} {measure_of(scene, name):.6g}  "
                      f"({n} {'cells' if kind == 'volume' else 'facets'})")
     return "\n".join(lines)
+
+
+def scene_cli(builder, float_options, argv=None, description=None) -> Scene:
+    """Command line of a scene builder: build it, print labels and measures, optionally XDMF.
+
+    Args:
+        builder: a collective scene builder (``meshes.flat_punch.flat_punch`` ...).
+        float_options: names of the builder's float keywords exposed as ``--name`` options
+            (underscores become dashes).
+        argv: arguments (default ``sys.argv[1:]``).
+    """
+    import argparse
+    import logging
+
+    logging.getLogger().setLevel(logging.WARNING)
+    parser = argparse.ArgumentParser(description=description, allow_abbrev=False)
+    for name in float_options:
+        parser.add_argument("--" + name.replace("_", "-"), dest=name, type=float, default=None)
+    parser.add_argument("--order", type=int, default=1)
+    parser.add_argument("--cell-type", default=None, choices=["tetrahedron", "hexahedron"])
+    parser.add_argument("--xdmf", default=None, help="write mesh and tags to this file")
+    opts = parser.parse_args(argv)
+    kwargs = {k: v for k, v in vars(opts).items() if k != "xdmf" and v is not None}
+    scene = builder(**kwargs)
+    text = describe(scene)
+    if scene.mesh.comm.rank == 0:
+        print(text)
+    if opts.xdmf:
+        write_xdmf(scene, opts.xdmf)
+    return scene
