@@ -18,7 +18,7 @@ import demo_flat_punch as demo  # noqa: E402
 from rough_contact.solver.loading import load_path, load_unload_factors  # noqa: E402
 
 # the elastic population builds its normal-law table in ~1 s (elasto-plastic: ~15 s)
-COARSE = dict(mesh_size=20.0, contact_size=2.5, normal_law="elastic")
+COARSE = dict(mesh_size=20.0, contact_size=2.5, order=1, normal_law="elastic")
 
 
 def run_punch(comm, steps=4, n_unload=1, prefix="test_punch_"):
@@ -69,7 +69,7 @@ def test_punch_results_do_not_depend_on_rank_count():
 def test_demo_main_small(tmp_path):
     comm = MPI.COMM_WORLD
     outdir = comm.bcast(str(tmp_path), root=0)
-    res = demo.main(mesh_size=20.0, contact_size=5.0, steps=2, outdir=outdir, comm=comm,
+    res = demo.main(mesh_size=20.0, contact_size=5.0, order=1, steps=2, outdir=outdir, comm=comm,
                     normal_law="elastic",
                     prefix="test_demo_", verbose=False)
     assert res["max_force_error"] < 1e-8
