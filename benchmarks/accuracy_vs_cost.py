@@ -82,7 +82,6 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
 
 import demo_beam_rigid_base as beam_demo  # noqa: E402
 import demo_flat_punch as punch_demo  # noqa: E402
-from meshes.flat_punch import flat_punch  # noqa: E402
 from rough_contact.fem.contact import ContactInterface  # noqa: E402
 from rough_contact.fem.problem import ContactProblem, Material, SurfaceLoad  # noqa: E402
 from rough_contact.solver.loading import load_path, load_unload_factors  # noqa: E402
@@ -210,51 +209,15 @@ def run_punch(comm, mesh, order, quadrature, steps, rtol, kind):
     comm.Barrier()
     t0 = time.perf_counter()
     mesh_size, contact_size = mesh
-    scene = flat_punch(mesh_size=mesh_size, contact_size=contact_size, order=order,
-                       load_half_width=2.5, comm=comm)
-    t_mesh = time.perf_counter() - t0
     normal, t_law = normal_law(comm, "punch", kind, rtol)
     t1 = time.perf_counter()
-    V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", order))
-    fdim = scene.mesh.topology.dim - 1
-
-    def dofs(name, comp=None):
-        facets = scene.facet_tags.find(scene.tag(name))
-        if comp is None:
-            return fem.locate_dofs_topological(V, fdim, facets)
-        return fem.locate_dofs_topological(V.sub(comp), fdim, facets)
-
-    zero = PETSc.ScalarType(0.0)
-    bcs = [fem.dirichletbc(zero, dofs("symmetry_x", 0), V.sub(0)),
-           fem.dirichletbc(zero, dofs("symmetry_y", 1), V.sub(1)),
-           fem.dirichletbc(np.zeros(3, dtype=PETSc.ScalarType), dofs("fixed"), V)]
-    quarter_force = punch_demo.TOTAL_FORCE / 4.0
-    a = scene.dimensions["half_width"]
     # seating held at the demo default (16 increments) for every run
-    p_seat = quarter_force / DEFAULTS["punch"]["steps"] / a**2
-    from rough_contact.interface.friction import OrthotropicSlipHardening
-    from rough_contact.interface.law import InterfaceLaw
-    from rough_contact.interface.tangential import TangentialStiffness
-
-    c = punch_demo.FRICTION_CASES["b"]
-    law = InterfaceLaw(normal=normal, tangential=TangentialStiffness(c["kt"]),
-                       friction=OrthotropicSlipHardening(
-                           mu_macro=c["mu_macro"], mu_initial_ratio=c["mu_initial_ratio"],
-                           hardening=punch_demo.HARDENING, potential_axes=c["nu"])
-                       ).with_seating(p_seat)
-    first, second = scene.contact_pair
-    qdeg = 2 * order if quadrature is None else quadrature
-    interface = ContactInterface(V, scene.facet_tags, first, second, law=law,
-                                 grain_direction=(1.0, 0.0, 0.0), quadrature_degree=qdeg,
-                                 bcs=bcs)
-    materials = {scene.tag("punch"): Material(punch_demo.E, punch_demo.NU),
-                 scene.tag("foundation"): Material(punch_demo.E, punch_demo.NU)}
-    loads = [SurfaceLoad(scene.tag("load"), force=[0.0, 0.0, -quarter_force])]
-    problem = ContactProblem(V, materials, bcs, loads, cell_tags=scene.cell_tags,
-                             facet_tags=scene.facet_tags, interface=interface,
-                             seating_tag=first, seating_stiffness=1e3)
-    problem.body_cells = [scene.cell_tags.find(scene.tag(b)) for b in scene.bodies]
-    solver = SNESSolver(problem, prefix="rc_", dof_threshold=100_000)
+    m = punch_demo.build(comm, mesh_size, contact_size, order, load_half_width=2.5, case="b",
+                         steps=steps, quadrature_degree=quadrature, normal=normal,
+                         seating_steps=DEFAULTS["punch"]["steps"])
+    scene, problem, solver, interface = m["scene"], m["problem"], m["solver"], m["interface"]
+    a = scene.dimensions["half_width"]
+    t_mesh = 0.0  # included in t_solve (the demo's build makes mesh and problem together)
     # mean u_z over the load patch (the punch approach)
     ds = __import__("ufl").Measure("ds", domain=scene.mesh, subdomain_data=scene.facet_tags)
     load_ds = ds(scene.tag("load"))

@@ -134,7 +134,9 @@ def effective_modulus(E1, nu1, E2, nu2):
 # copy); the friction law is the orthotropic slip-hardening model with Mindlin-type tangential
 # stiffness kT = c kN.  ``law="penalty"`` gives a smooth unilateral penalty with Coulomb friction
 # instead (a stand-in for debugging the FE layer).
-def make_law(comm, law="rough", case="b", normal_law="elastic", seating_pressure=None):
+def make_law(comm, law="rough", case="b", normal_law="elastic", seating_pressure=None,
+             normal=None):
+    """Interface law and its normal law; ``normal`` (a prebuilt NormalLaw) skips the build."""
     from rough_contact.interface.friction import OrthotropicSlipHardening
     from rough_contact.interface.law import InterfaceLaw
     from rough_contact.interface.penalty import SoftplusPenalty
@@ -146,24 +148,23 @@ def make_law(comm, law="rough", case="b", normal_law="elastic", seating_pressure
         raise ValueError(f"law = {law!r} is invalid; valid values: 'rough', 'penalty'")
     if case not in FRICTION_CASES and case != "none":
         raise ValueError(f"friction case = {case!r} is invalid; valid: a, b, c, none")
-    normal = None
-    if comm.rank == 0:
-        from rough_contact.interface.normal import NormalLaw
-        from rough_contact.surface import SpectralMoments
-
-        surface = SpectralMoments(**MOMENTS_UM, unit="um")
-        E_star = effective_modulus(E, NU, E, NU)
-        if normal_law == "elastic":
-            normal = NormalLaw.elastic(surface, E_star)
-        elif normal_law == "elasto-plastic":
+    if normal_law not in ("elastic", "elasto-plastic"):  # checked on every rank: no hang
+        raise ValueError(f"normal_law = {normal_law!r} is invalid; valid values: "
+                         "'elastic', 'elasto-plastic'")
+    if normal is None:
+        if comm.rank == 0:  # the table is built once and copied to the other ranks
             from rough_contact.asperity import AsperityMaterial
+            from rough_contact.interface.normal import NormalLaw
+            from rough_contact.surface import SpectralMoments
 
-            normal = NormalLaw.elasto_plastic(surface, AsperityMaterial(E_star=E_star, nu=NU,
-                                                                        **PLASTIC))
-        else:
-            raise ValueError(f"normal_law = {normal_law!r} is invalid; valid values: "
-                             "'elastic', 'elasto-plastic'")
-    normal = comm.bcast(normal, root=0)
+            surface = SpectralMoments(**MOMENTS_UM, unit="um")
+            E_star = effective_modulus(E, NU, E, NU)
+            if normal_law == "elastic":
+                normal = NormalLaw.elastic(surface, E_star)
+            else:
+                normal = NormalLaw.elasto_plastic(
+                    surface, AsperityMaterial(E_star=E_star, nu=NU, **PLASTIC))
+        normal = comm.bcast(normal, root=0)
     if case == "none":
         rough = InterfaceLaw(normal=normal)
     else:
@@ -179,8 +180,11 @@ def make_law(comm, law="rough", case="b", normal_law="elastic", seating_pressure
 # ## Scene, spaces, conditions, problem
 def build(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2, load_half_width=2.5,
           law="rough", case="b", normal_law="elasto-plastic", steps=16, prefix="rc_",
-          dof_threshold=100_000, quadrature_degree=None):
+          dof_threshold=100_000, quadrature_degree=None, normal=None, seating_steps=None):
     """Mesh, law, interface, problem and solver of the quarter punch. Collective.
+
+    ``normal`` passes a prebuilt NormalLaw (same on every rank); ``seating_steps`` (default
+    ``steps``) sets the seating pressure to the nominal pressure of 1/seating_steps of the load.
 
     Returns:
         dict with keys scene, V, law, normal, interface, problem, solver, quarter_force.
@@ -204,8 +208,9 @@ def build(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2, load_h
     quarter_force = TOTAL_FORCE / 4.0
     contact_area = scene.dimensions["half_width"] ** 2
     # Seat the rough surfaces with the nominal pressure of the first increment.
-    p_seat = quarter_force / steps / contact_area
-    interface_law, normal = make_law(comm, law, case, normal_law, seating_pressure=p_seat)
+    p_seat = quarter_force / (seating_steps or steps) / contact_area
+    interface_law, normal = make_law(comm, law, case, normal_law, seating_pressure=p_seat,
+                                     normal=normal)
 
     first, second = scene.contact_pair
     qdeg = quadrature_degree if quadrature_degree is not None else 2 * order
