@@ -180,7 +180,8 @@ def make_law(comm, law="rough", case="b", normal_law="elastic", seating_pressure
 # ## Scene, spaces, conditions, problem
 def build(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2, load_half_width=2.5,
           law="rough", case="b", normal_law="elasto-plastic", steps=16, prefix="rc_",
-          dof_threshold=100_000, quadrature_degree=None, normal=None, seating_steps=None):
+          dof_threshold=100_000, quadrature_degree=None, normal=None, seating_steps=None,
+          cell_type="tetrahedron"):
     """Mesh, law, interface, problem and solver of the quarter punch. Collective.
 
     ``normal`` passes a prebuilt NormalLaw (same on every rank); ``seating_steps`` (default
@@ -190,7 +191,7 @@ def build(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2, load_h
         dict with keys scene, V, law, normal, interface, problem, solver, quarter_force.
     """
     scene = flat_punch(mesh_size=mesh_size, contact_size=contact_size, order=order,
-                       load_half_width=load_half_width, comm=comm)
+                       load_half_width=load_half_width, cell_type=cell_type, comm=comm)
     V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", order))
     fdim = scene.mesh.topology.dim - 1
 

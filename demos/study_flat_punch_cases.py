@@ -33,8 +33,6 @@
 from __future__ import annotations
 
 import argparse
-import contextlib
-import functools
 import json
 import os
 import sys
@@ -50,25 +48,6 @@ from rough_contact.solver.loading import load_path, load_unload_factors  # noqa:
 from rough_contact.solver.output import gather_points  # noqa: E402
 
 FLIP = np.array([1.0, -1.0])  # local (x, y) -> global (x, y): y_local = n x x = -y_global
-
-
-@contextlib.contextmanager
-def cell_type_of_demo(cell_type: str):
-    """Make ``demo.build`` mesh with ``cell_type`` ("tetrahedron" or "hexahedron").
-
-    ``demo_flat_punch.build`` does not expose the mesh's cell type; it calls the module-level
-    name ``flat_punch``, which is swapped here for a partial with ``cell_type`` (restored on
-    exit). The hexahedral mesh is structured and mirror-symmetric about x = y.
-    """
-    if cell_type not in ("tetrahedron", "hexahedron"):
-        raise ValueError(f"cell_type = {cell_type!r} is invalid; valid: 'tetrahedron', "
-                         "'hexahedron'")
-    original = demo.flat_punch
-    demo.flat_punch = functools.partial(original, cell_type=cell_type)
-    try:
-        yield
-    finally:
-        demo.flat_punch = original
 
 
 def snapshot(comm, interface):
@@ -128,10 +107,9 @@ def run_case(case, comm=MPI.COMM_WORLD, mesh_size=10.0, contact_size=1.0, order=
     """
     t0 = MPI.Wtime()
     n_unload = steps - 1 if n_unload is None else n_unload
-    with cell_type_of_demo(cell_type):
-        m = demo.build(comm=comm, mesh_size=mesh_size, contact_size=contact_size, order=order,
-                       load_half_width=load_half_width, law="rough", case=case,
-                       normal_law=normal_law, steps=steps, prefix=prefix)
+    m = demo.build(comm=comm, mesh_size=mesh_size, contact_size=contact_size, order=order,
+                   load_half_width=load_half_width, law="rough", case=case,
+                   normal_law=normal_law, steps=steps, prefix=prefix, cell_type=cell_type)
     interface, problem, solver = m["interface"], m["problem"], m["solver"]
     factors = load_unload_factors(steps, n_unload, final_factor)
     history, peak, snap = [], None, None
