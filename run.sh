@@ -77,12 +77,12 @@ case "$cmd" in
     test)
         setup
         echo "== unit tests (pure numpy) =="
-        run_pytest "$PY" -m pytest -q tests/unit
+        run_pytest "$PY" -m pytest -q --color=no tests/unit
         if compgen -G "tests/fem/test_*.py" > /dev/null; then
             echo "== FE tests, serial =="
-            run_pytest "$PY" -m pytest -q tests/fem
+            run_pytest "$PY" -m pytest -q --color=no tests/fem
             echo "== FE tests, mpirun -n 2 =="
-            run_pytest mpirun -n 2 "$PY" -m mpi4py -m pytest -q -p no:cacheprovider tests/fem
+            run_pytest mpirun -n 2 "$PY" -m mpi4py -m pytest -q --color=no -p no:cacheprovider tests/fem
         fi ;;
     python)
         setup
