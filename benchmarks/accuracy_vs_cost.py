@@ -637,12 +637,9 @@ def write_report(args):
 
 
 if __name__ == "__main__":
-    def _abort_on_error(exc_type, exc, tb):
-        sys.__excepthook__(exc_type, exc, tb)
-        sys.stderr.flush()
-        MPI.COMM_WORLD.Abort(1)
+    from rough_contact.solver.parallel import abort_on_uncaught_exception
 
-    sys.excepthook = _abort_on_error
+    abort_on_uncaught_exception()  # one failing rank must not leave the others waiting
     comm = MPI.COMM_WORLD
     if ARGS.merge_from and comm.rank == 0:
         have = {(r["mode"], r["example"], r["knob"], r["level"], r["ranks"])

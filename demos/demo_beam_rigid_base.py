@@ -569,6 +569,9 @@ def main(cases=tuple(sorted(CASES)), mesh_size=40.0, contact_size=5.0, order=2,
 
 
 if __name__ == "__main__":
+    from rough_contact.solver.parallel import abort_on_uncaught_exception
+
+    abort_on_uncaught_exception()  # one failing rank must not leave the others waiting
     args = ARGS
     main(cases=args.cases, mesh_size=args.mesh_size, contact_size=args.contact_size,
          order=args.order, load_half_length=args.load_half_length, steps=args.steps,

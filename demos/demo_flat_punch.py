@@ -343,13 +343,9 @@ def main(mesh_size=20.0, contact_size=2.0, order=2, load_half_width=2.5, steps=1
 
 
 if __name__ == "__main__":
-    # An exception on one rank must not leave the others waiting in a collective.
-    def _abort_on_error(exc_type, exc, tb):
-        sys.__excepthook__(exc_type, exc, tb)
-        sys.stderr.flush()
-        MPI.COMM_WORLD.Abort(1)
+    from rough_contact.solver.parallel import abort_on_uncaught_exception
 
-    sys.excepthook = _abort_on_error
+    abort_on_uncaught_exception()  # one failing rank must not leave the others waiting
     args = ARGS
     main(mesh_size=args.mesh_size, contact_size=args.contact_size, order=args.order,
          load_half_width=args.load_half_width, steps=args.steps, unload=not args.no_unload,

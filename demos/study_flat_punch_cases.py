@@ -315,10 +315,7 @@ def main(argv=None, comm=MPI.COMM_WORLD):
 
 
 if __name__ == "__main__":
-    def _abort_on_error(exc_type, exc, tb):
-        sys.__excepthook__(exc_type, exc, tb)
-        sys.stderr.flush()
-        MPI.COMM_WORLD.Abort(1)
+    from rough_contact.solver.parallel import abort_on_uncaught_exception
 
-    sys.excepthook = _abort_on_error
+    abort_on_uncaught_exception()  # one failing rank must not leave the others waiting
     main()

@@ -32,7 +32,7 @@ import numpy as np
 from mpi4py import MPI
 
 from rough_contact.fem.mesh import (Scene, add_groups, build_scene, entity_centers,
-                                    set_transfinite_hexahedra, validate_cell_type,
+                                    refine_towards, set_transfinite_hexahedra, validate_cell_type,
                                     validate_order, validate_positive)
 
 __all__ = ["beam_on_base"]
@@ -112,20 +112,7 @@ def beam_on_base(mesh_size: float = 20.0, contact_size: typing.Optional[float] =
             set_transfinite_hexahedra(model, contact_size, mesh_size,
                                       lambda p, axis: abs(p[2]) if axis == 2 else 0.0)
         else:
-            field = model.mesh.field
-            dist = field.add("MathEval")
-            field.setString(dist, "F", "Abs(z)")
-            thr = field.add("Threshold")
-            field.setNumber(thr, "InField", dist)
-            field.setNumber(thr, "SizeMin", contact_size)
-            field.setNumber(thr, "SizeMax", mesh_size)
-            field.setNumber(thr, "DistMin", 0.0)
-            field.setNumber(thr, "DistMax", transition)
-            field.setAsBackgroundMesh(thr)
-            gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
-            gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
-            gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
-            gmsh.option.setNumber("Mesh.MeshSizeMax", mesh_size)
+            refine_towards(model, "Abs(z)", contact_size, mesh_size, transition)
         model.mesh.generate(3)
         if order == 2:
             gmsh.option.setNumber("Mesh.SecondOrderIncomplete", 0)

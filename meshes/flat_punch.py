@@ -36,7 +36,7 @@ import numpy as np
 from mpi4py import MPI
 
 from rough_contact.fem.mesh import (Scene, add_groups, build_scene, entity_centers,
-                                    set_transfinite_hexahedra, validate_cell_type,
+                                    refine_towards, set_transfinite_hexahedra, validate_cell_type,
                                     validate_order, validate_positive)
 
 __all__ = ["flat_punch"]
@@ -44,23 +44,8 @@ __all__ = ["flat_punch"]
 
 def _refinement_field(model, a, contact_size, mesh_size, transition):
     """Threshold on the exact distance to the patch [0, a]^2 x {0}: contact_size -> mesh_size."""
-    import gmsh
-
-    field = model.mesh.field
-    dist = field.add("MathEval")
     dx, dy = f"(Abs(x-{a})+x-{a})/2", f"(Abs(y-{a})+y-{a})/2"
-    field.setString(dist, "F", f"Sqrt(({dx})^2+({dy})^2+z^2)")
-    thr = field.add("Threshold")
-    field.setNumber(thr, "InField", dist)
-    field.setNumber(thr, "SizeMin", contact_size)
-    field.setNumber(thr, "SizeMax", mesh_size)
-    field.setNumber(thr, "DistMin", 0.0)
-    field.setNumber(thr, "DistMax", transition)
-    field.setAsBackgroundMesh(thr)
-    gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
-    gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
-    gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
-    gmsh.option.setNumber("Mesh.MeshSizeMax", mesh_size)
+    refine_towards(model, f"Sqrt(({dx})^2+({dy})^2+z^2)", contact_size, mesh_size, transition)
 
 
 def flat_punch(mesh_size: float = 10.0, contact_size: typing.Optional[float] = None,

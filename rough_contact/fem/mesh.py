@@ -659,3 +659,30 @@ def scene_cli(builder, float_options, argv=None, description=None) -> Scene:
     if opts.xdmf:
         write_xdmf(scene, opts.xdmf)
     return scene
+
+
+def refine_towards(model, distance: str, contact_size: float, mesh_size: float,
+                   transition: float) -> None:
+    """Element size from ``contact_size`` at distance 0 to ``mesh_size`` beyond ``transition``.
+
+    Args:
+        model: ``gmsh.model``.
+        distance: gmsh MathEval expression in x, y, z of the exact distance to the contact
+            region [mm] (exact, unlike gmsh's sampled Distance field).
+    """
+    import gmsh
+
+    field = model.mesh.field
+    dist = field.add("MathEval")
+    field.setString(dist, "F", distance)
+    thr = field.add("Threshold")
+    field.setNumber(thr, "InField", dist)
+    field.setNumber(thr, "SizeMin", contact_size)
+    field.setNumber(thr, "SizeMax", mesh_size)
+    field.setNumber(thr, "DistMin", 0.0)
+    field.setNumber(thr, "DistMax", transition)
+    field.setAsBackgroundMesh(thr)
+    gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
+    gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
+    gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
+    gmsh.option.setNumber("Mesh.MeshSizeMax", mesh_size)
