@@ -150,6 +150,8 @@ class ContactProblem:
             changed).
         seating_stiffness: see ``seating_tag`` [MPa/mm].
         quadrature_degree: optional quadrature degree for the bulk forms.
+        body_cells: local cell indices of each disconnected body (one array per body), for a
+            near-nullspace built per body; empty = the six global rigid-body modes.
     """
 
     def __init__(
@@ -164,12 +166,14 @@ class ContactProblem:
         seating_tag: Optional[int] = None,
         seating_stiffness: float = 0.0,
         quadrature_degree: Optional[int] = None,
+        body_cells: Sequence[np.ndarray] = (),
     ):
         msh = V.mesh
         self.V, self.mesh, self.comm = V, msh, msh.comm
         self.bcs = list(bcs)
         self.loads = list(loads)
         self.interface = interface
+        self.body_cells = [np.asarray(c, dtype=np.int32) for c in body_cells]
         self.load_factor = 0.0
         self.u = fem.Function(V, name="displacement")
 

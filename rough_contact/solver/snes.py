@@ -143,7 +143,7 @@ class SNESSolver:
             if near_nullspace is None:
                 from rough_contact.fem.problem import rigid_body_modes
 
-                near_nullspace = rigid_body_modes(problem.V, getattr(problem, "body_cells", ()))
+                near_nullspace = rigid_body_modes(problem.V, problem.body_cells)
             problem.A.setNearNullSpace(near_nullspace)
             problem.K.setNearNullSpace(near_nullspace)
         self.near_nullspace = near_nullspace

@@ -1,0 +1,164 @@
+"""The interface-law contract: what every law evaluated at contact points takes and returns.
+
+This module is the hand-off between the pure-numpy laws (``rough_contact.interface``) and the
+finite-element layer (``rough_contact.fem.contact.ContactInterface``). A law written by a user
+plugs in by satisfying :class:`InterfaceLawProtocol` and returning :class:`LawResult`; nothing
+else is looked up on it. ``docs/writing_a_law.md`` walks through a complete user law.
+
+Units: mm, N, MPa. Jumps and gaps [mm]; tractions and pressures [MPa]; stiffnesses per nominal
+area [MPa/mm]; dissipation per nominal area [N/mm] (= MPa mm).
+
+Local axes and the jump
+-----------------------
+At every interface point the FE layer builds an orthonormal frame (n, x, y):
+
+* n is the unit normal of the FIRST surface, pointing towards the second body;
+* x is the user's grain direction projected on the surface (the paper's grinding direction);
+* y = n x x.
+
+``jump`` (n_pts, 3) holds ``[g, s_x, s_y]``, the components of u_second - u_first in that frame
+(plus the initial gap for a rigid obstacle). g > 0 opens the interface.
+
+Traction and tangent
+--------------------
+The traction is energy-conjugate to the jump, ``t = dpsi/djump`` for the interface free energy
+psi, so in compression ``t_N = -p <= 0`` and the friction traction points along the elastic
+slip. The FE residual is ``R = int B^T t dA`` and the Jacobian ``int B^T D B dA`` with
+``D = dt/djump`` (n_pts, 3, 3) the ALGORITHMIC tangent of the discrete (backward-Euler) update,
+which is non-symmetric for non-associated friction. A wrong tangent costs Newton iterations but
+never changes a converged answer.
+
+History
+-------
+``evaluate`` is a pure function of ``(jump, committed)``: it must never mutate ``committed``
+(SNES line searches evaluate trial points that are thrown away). It returns the trial state
+that the interface stores; the interface commits it once per converged increment and drops it
+on a cutback. The law reports the dissipation INCREMENT of the step, ``t_T . Delta s_p``
+per nominal area; the interface accumulates it (one place).
+
+Failures
+--------
+A law raises :class:`ConvergenceError` (or a subclass, e.g. the friction return map's
+``ReturnMappingError``) when a smaller load increment may cure the failure: the load stepping
+then cuts back. Any other exception (bad input, programming error) propagates at once with its
+own type and traceback.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Protocol, TypeVar, runtime_checkable
+
+import numpy as np
+
+__all__ = ["ConvergenceError", "LawState", "LawResult", "InterfaceLawProtocol",
+           "LawContractError"]
+
+
+class ConvergenceError(ArithmeticError):
+    """A failure that a smaller load increment may cure (a local Newton that did not converge,
+    a non-finite jump from a diverging global iterate). Load stepping cuts back on it."""
+
+
+class LawContractError(TypeError):
+    """A law's result does not follow the contract (missing field, wrong shape or dtype)."""
+
+
+S = TypeVar("S", bound="LawState")
+
+
+@runtime_checkable
+class LawState(Protocol):
+    """Per-point history of a law at n points (arrays batch-first).
+
+    Attributes:
+        plastic_slip: (n, 2) irreversible tangential slip (s_p,x, s_p,y) in local axes [mm]
+            (zeros for a law without friction history).
+    """
+
+    plastic_slip: np.ndarray
+
+    def copy(self: S) -> S:
+        """Deep copy (the committed state must not share memory with a trial state)."""
+        ...
+
+    def __len__(self) -> int:
+        """Number of points n."""
+        ...
+
+
+@dataclass(frozen=True)
+class LawResult:
+    """Outcome of one law evaluation at n points; every law returns this type.
+
+    Attributes:
+        traction: (n, 3) float [t_N, t_x, t_y] [MPa], t = dpsi/djump, t_N = -p.
+        tangent: (n, 3, 3) float consistent tangent D = dt/djump [MPa/mm] (rows: traction
+            components, columns: jump components; non-symmetric in general).
+        state: trial history after this evaluation (a :class:`LawState` with n points).
+        dissipation: (n,) float dissipation increment t_T . Delta s_p >= 0 of this step [N/mm].
+        area_fraction: (n,) float real-area fraction A/A0 in [0, 1] [-].
+        contact: (n,) bool, p > 0 (the point carries load).
+        slipping: (n,) bool, the friction limit is active.
+    """
+
+    traction: np.ndarray
+    tangent: np.ndarray
+    state: LawState
+    dissipation: np.ndarray
+    area_fraction: np.ndarray
+    contact: np.ndarray
+    slipping: np.ndarray
+
+    @property
+    def pressure(self) -> np.ndarray:
+        """(n,) contact pressure p = -t_N [MPa]."""
+        return -self.traction[:, 0]
+
+    def check(self, n: int) -> None:
+        """Raise :class:`LawContractError` naming the first field that breaks the contract.
+
+        Checks types, shapes, dtypes and the state's length; finiteness of traction and tangent
+        is checked by the caller on every evaluation (a non-finite value is a convergence
+        failure, not a contract breach).
+        """
+        fields = (("traction", (n, 3), np.floating), ("tangent", (n, 3, 3), np.floating),
+                  ("dissipation", (n,), np.floating), ("area_fraction", (n,), np.floating),
+                  ("contact", (n,), np.bool_), ("slipping", (n,), np.bool_))
+        for name, shape, kind in fields:
+            value = getattr(self, name)
+            if not isinstance(value, np.ndarray):
+                raise LawContractError(f"LawResult.{name} must be a numpy array of shape {shape}, "
+                                       f"got {type(value).__name__}")
+            if value.shape != shape:
+                raise LawContractError(f"LawResult.{name} has shape {value.shape}, the contract "
+                                       f"needs {shape} for {n} points")
+            if not np.issubdtype(value.dtype, kind):
+                raise LawContractError(f"LawResult.{name} has dtype {value.dtype}, the contract "
+                                       f"needs {np.dtype(kind).name}")
+        if not isinstance(self.state, LawState):
+            raise LawContractError(
+                f"LawResult.state ({type(self.state).__name__}) must have a plastic_slip array, "
+                "copy() and __len__ (rough_contact.interface.contract.LawState)")
+        if len(self.state) != n or np.shape(self.state.plastic_slip) != (n, 2):
+            raise LawContractError(
+                f"LawResult.state holds {len(self.state)} points with plastic_slip of shape "
+                f"{np.shape(self.state.plastic_slip)}; the contract needs {n} and ({n}, 2)")
+
+
+@runtime_checkable
+class InterfaceLawProtocol(Protocol):
+    """An interface law evaluated at all points of an interface in one vectorised call."""
+
+    def initial_state(self, n_points: int) -> LawState:
+        """Virgin history at ``n_points`` points."""
+        ...
+
+    def evaluate(self, jump: np.ndarray, committed: LawState) -> LawResult:
+        """Traction, tangent and trial state at ``jump`` (n, 3) [mm]; never mutates input.
+
+        Raises:
+            ConvergenceError: a failure a smaller load increment may cure.
+            ValueError: bad input (wrong shapes, unset parameters).
+        """
+        ...
