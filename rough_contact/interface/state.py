@@ -61,27 +61,42 @@ class InterfaceState:
 
 
 class StatePair:
-    """Committed and trial history of one interface.
+    """Committed and trial history of one interface, and the dissipation accumulated over it.
+
+    The one place where history is committed or dropped and where the dissipation increments
+    that laws report are summed (``rough_contact.interface.contract``).
 
     Args:
-        committed: the converged state; ``trial`` starts as a copy of it.
+        committed: the converged state (any ``LawState``); ``trial`` starts as a copy of it.
+
+    Attributes:
+        committed: state at the last converged increment.
+        trial: state of the latest law evaluation.
+        dissipated: (n,) dissipation per nominal area summed over committed increments [N/mm].
     """
 
-    def __init__(self, committed: InterfaceState):
+    def __init__(self, committed):
         self.committed = committed
         self.trial = committed.copy()
+        n = len(committed)
+        self.dissipated = np.zeros(n)
+        self._pending = np.zeros(n)
 
-    def update(self, trial: InterfaceState) -> None:
-        """Store the trial state returned by the latest law evaluation."""
-        if len(trial) != len(self.committed):
-            raise ValueError(
-                f"trial state has {len(trial)} points, committed has {len(self.committed)}")
-        self.trial = trial
+    def update(self, result) -> None:
+        """Store the trial state and dissipation increment of a law evaluation (``LawResult``)."""
+        if len(result.state) != len(self.committed):
+            raise ValueError(f"trial state has {len(result.state)} points, committed has "
+                             f"{len(self.committed)}")
+        self.trial = result.state
+        self._pending = result.dissipation
 
     def commit(self) -> None:
-        """Accept the trial state (after the global Newton converged)."""
+        """Accept the trial state and its dissipation (after the global Newton converged)."""
         self.committed = self.trial.copy()
+        self.dissipated = self.dissipated + self._pending
+        self._pending = np.zeros_like(self.dissipated)
 
     def revert(self) -> None:
         """Discard the trial state (after the global Newton failed, before the cutback)."""
         self.trial = self.committed.copy()
+        self._pending = np.zeros_like(self.dissipated)
