@@ -4,6 +4,9 @@
 #   bash run.sh test             the test suite: unit tests, FE tests serial and on 2 ranks
 #   bash run.sh setup            only the set-up (idempotent, fast when done)
 #   bash run.sh python ...       run a command with the project's interpreter and environment
+# Optional extras (pyproject [project.optional-dependencies]) are installed when asked:
+#   RC_EXTRAS=bem,topography bash run.sh setup
+# The test command asks for the extras its tests need (TEST_EXTRAS below).
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 cd "$here"
@@ -11,6 +14,7 @@ cd "$here"
 DEB_PACKAGES=(python3-dolfinx python3-gmsh python3-scipy python3-pytest python3-matplotlib
               python3-venv python3-wheel libopenblas0-pthread openmpi-bin)
 VENV="$here/.venv"
+TEST_EXTRAS=""
 PY="$VENV/bin/python"
 
 setup() {
@@ -37,10 +41,13 @@ import numpy, scipy
 print(f"numpy=={numpy.__version__}\nscipy=={scipy.__version__}")
 PYEOF
     mv "$cons.new" "$cons"
-    local stamp="$VENV/.installed"
+    local extras="${RC_EXTRAS:-}"
+    local target="."
+    [ -z "$extras" ] || target=".[$extras]"
+    local stamp="$VENV/.installed${extras:+-${extras//,/-}}"
     if [ ! -f "$stamp" ] || [ pyproject.toml -nt "$stamp" ]; then
-        echo "[setup] pip install -e . (constraints: $(tr '\n' ' ' < "$cons"))"
-        "$PY" -m pip install -q --no-build-isolation -c "$cons" -e . 
+        echo "[setup] pip install -e $target (constraints: $(tr '\n' ' ' < "$cons"))"
+        "$PY" -m pip install -q --no-build-isolation -c "$cons" -e "$target"
         touch "$stamp"
     fi
 }
@@ -75,7 +82,7 @@ case "$cmd" in
             exec "$PY" demos/demo_micro_model.py "$@"
         fi ;;
     test)
-        setup
+        RC_EXTRAS="${RC_EXTRAS:-$TEST_EXTRAS}" setup
         echo "== unit tests (pure numpy) =="
         run_pytest "$PY" -m pytest -q --color=no tests/unit
         if compgen -G "tests/fem/test_*.py" > /dev/null; then
