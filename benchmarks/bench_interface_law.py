@@ -48,7 +48,7 @@ def best_time(fn, repeat):
 def jumps(law, n, regime, rng):
     """Jumps (n, 3) and a committed state for one regime."""
     st = InterfaceState(rng.normal(size=(n, 2)) * 1e-4, rng.uniform(0, 1e-4, (n, 2)),
-                        rng.uniform(0, 1e-4, n), np.zeros(n))
+                        rng.uniform(0, 1e-4, n))
     g = rng.uniform(-2e-4, 2e-4, n)  # around the seating separation (contact)
     _, k, _ = law.normal.evaluate(law.h0 + g)
     kt_min = min(law.tangential.kt_over_kn) * k
@@ -68,7 +68,7 @@ def jumps(law, n, regime, rng):
         parts = [jumps(law, n // 3 + 1, r, rng) for r in ("stick", "slip", "open")]
         jj = np.concatenate([p_[0] for p_ in parts])[:n]
         cat = [np.concatenate([getattr(p_[1], a) for p_ in parts])[:n]
-               for a in ("plastic_slip", "accumulated_slip", "slip_path", "dissipated")]
+               for a in ("plastic_slip", "accumulated_slip", "slip_path")]
         return jj, InterfaceState(*cat)
     return np.column_stack([g, s]), st
 

@@ -40,8 +40,18 @@ Failures
 --------
 A law raises :class:`ConvergenceError` (or a subclass, e.g. the friction return map's
 ``ReturnMappingError``) when a smaller load increment may cure the failure: the load stepping
-then cuts back. Any other exception (bad input, programming error) propagates at once with its
-own type and traceback.
+then cuts back. A non-finite jump is such a failure (a diverging global iterate), so
+:func:`check_jump` raises ``ConvergenceError`` for it. Any other exception (bad input such as a
+wrong shape: ``ValueError``; a programming error) propagates at once with its own type and
+traceback.
+
+Built-in laws
+-------------
+``rough_contact.interface.law.InterfaceLaw`` (rough surface + friction) and
+``rough_contact.interface.penalty.LinearPenalty`` / ``SoftplusPenalty`` follow this contract and
+keep their history in ``rough_contact.interface.state.InterfaceState``;
+``rough_contact.interface.state.StatePair`` is the committed/trial bookkeeping that sums the
+dissipation increments.
 """
 
 from __future__ import annotations
@@ -52,7 +62,7 @@ from typing import Protocol, TypeVar, runtime_checkable
 import numpy as np
 
 __all__ = ["ConvergenceError", "LawState", "LawResult", "InterfaceLawProtocol",
-           "LawContractError"]
+           "LawContractError", "check_jump"]
 
 
 class ConvergenceError(ArithmeticError):
@@ -162,3 +172,33 @@ class InterfaceLawProtocol(Protocol):
             ValueError: bad input (wrong shapes, unset parameters).
         """
         ...
+
+
+def check_jump(jump, committed: LawState) -> np.ndarray:
+    """Validate the arguments of ``evaluate`` as the contract requires; return the jump.
+
+    Args:
+        jump: (n, 3) [g, s_x, s_y] [mm].
+        committed: the committed state; must hold n points.
+
+    Returns:
+        ``jump`` as a float array (n, 3) (no copy if it already is one).
+
+    Raises:
+        ValueError: ``jump`` is not (n, 3), or ``committed`` is not a ``LawState`` of n points.
+        ConvergenceError: ``jump`` is not finite somewhere (names the count and the first index).
+    """
+    jump = np.asarray(jump, dtype=float)
+    if jump.ndim != 2 or jump.shape[1] != 3:
+        raise ValueError(f"jump must have shape (n_pts, 3), got {jump.shape}")
+    n = jump.shape[0]
+    if not isinstance(committed, LawState) or len(committed) != n:
+        got = (f"{len(committed)} points" if isinstance(committed, LawState)
+               else type(committed).__name__)
+        raise ValueError(f"committed state must be a LawState with {n} points (as jump), "
+                         f"got {got}")
+    if not np.isfinite(jump).all():
+        bad = np.flatnonzero(~np.isfinite(jump).all(axis=1))
+        raise ConvergenceError(f"jump is not finite at {bad.size} of {n} points (first index "
+                               f"{bad[0]}): a diverging global iterate")
+    return jump

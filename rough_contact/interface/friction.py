@@ -61,6 +61,8 @@ from typing import Optional, Tuple
 
 import numpy as np
 
+from .contract import ConvergenceError
+
 __all__ = [
     "OrthotropicSlipHardening",
     "IsotropicSlipHardening",
@@ -77,8 +79,11 @@ _MAX_ITER = 80
 _RELEASE = 1e-16  # p < 1e-16 N_trial min(a)/max(a): closed-form release limit (no overflow)
 
 
-class ReturnMappingError(RuntimeError):
-    """The local Newton of the return map did not converge at some points."""
+class ReturnMappingError(ConvergenceError):
+    """The local Newton of the return map did not converge at some points.
+
+    A ``ConvergenceError``: a smaller load increment (a smaller slip increment) usually cures it.
+    """
 
 
 @dataclass(frozen=True)
