@@ -28,7 +28,7 @@ from .friction import IsotropicSlipHardening, OrthotropicSlipHardening, _Columns
 from .state import InterfaceState
 from .tangential import TangentialStiffness
 
-__all__ = ["InterfaceLaw", "NormalLawProtocol"]
+__all__ = ["InterfaceLaw", "NormalLawProtocol", "SeatableNormalLaw"]
 
 Friction = Union[OrthotropicSlipHardening, IsotropicSlipHardening]
 
@@ -38,7 +38,8 @@ class NormalLawProtocol(Protocol):
     """What ``InterfaceLaw`` needs from a normal law: p, kN, A/A0 (and dkN/dh) vs separation.
 
     ``rough_contact.interface.normal.NormalLaw`` (the statistical law) implements it; so can any
-    smooth law of the mean-plane separation h with p -> 0 as h grows.
+    smooth law of the mean-plane separation h with p -> 0 as h grows. ``with_seating`` needs the
+    inverse as well (:class:`SeatableNormalLaw`); a law used with an explicit ``h0`` does not.
     """
 
     def evaluate(self, h: np.ndarray, curvature: bool = False) -> Tuple[np.ndarray, ...]:
@@ -50,6 +51,11 @@ class NormalLawProtocol(Protocol):
             dk/dh [MPa/mm^2], each (n,) float.
         """
         ...
+
+
+@runtime_checkable
+class SeatableNormalLaw(NormalLawProtocol, Protocol):
+    """A normal law with the inverse p -> h, which ``InterfaceLaw.with_seating`` needs."""
 
     def separation_for_pressure(self, p: np.ndarray) -> np.ndarray:
         """Separation h (n,) [mm] at which the pressure is p (n,) > 0 [MPa] (inverse of p(h))."""
@@ -64,8 +70,9 @@ class InterfaceLaw:
     ``InterfaceState`` as history.
 
     Args:
-        normal: the normal law (``NormalLawProtocol``; e.g.
-            ``rough_contact.interface.normal.NormalLaw``).
+        normal: the normal law (``NormalLawProtocol``, e.g.
+            ``rough_contact.interface.normal.NormalLaw``; ``with_seating`` needs a
+            ``SeatableNormalLaw``).
         tangential: tangential stiffness ratios kT/kN (needed when ``friction`` is given).
         friction: ``OrthotropicSlipHardening`` or ``IsotropicSlipHardening``; None means
             frictionless (t_T = 0, no history).
@@ -80,8 +87,8 @@ class InterfaceLaw:
 
     def __post_init__(self) -> None:
         if not isinstance(self.normal, NormalLawProtocol):
-            raise ValueError(f"normal = {self.normal!r} must implement NormalLawProtocol: "
-                             "evaluate(h, curvature) and separation_for_pressure(p)")
+            raise ValueError(f"normal = {self.normal!r} must implement NormalLawProtocol "
+                             "(evaluate(h, curvature))")
         if self.friction is not None:
             if not isinstance(self.friction, (OrthotropicSlipHardening, IsotropicSlipHardening)):
                 raise ValueError(f"friction = {self.friction!r} must be an "
@@ -94,8 +101,17 @@ class InterfaceLaw:
             object.__setattr__(self, "h0", check_scalar("h0", self.h0, unit="mm"))
 
     def with_seating(self, p_seat: float) -> InterfaceLaw:
-        """Copy whose h0 solves p(h0) = p_seat [MPa] (zero gap carries the seating pressure)."""
+        """Copy whose h0 solves p(h0) = p_seat [MPa] (zero gap carries the seating pressure).
+
+        Raises:
+            ValueError: p_seat not finite and > 0, or a normal law without the inverse
+                (``SeatableNormalLaw``).
+        """
         p = check_scalar("p_seat", p_seat, lo=0.0, unit="MPa")
+        if not isinstance(self.normal, SeatableNormalLaw):
+            raise ValueError(f"with_seating needs a normal law with separation_for_pressure(p) "
+                             f"(SeatableNormalLaw); {type(self.normal).__name__} has none: give "
+                             "h0 directly")
         h0 = float(np.asarray(self.normal.separation_for_pressure(np.array([p]))).reshape(-1)[0])
         return dataclasses.replace(self, h0=h0)
 

@@ -296,5 +296,12 @@ def test_bad_law_input():
         InterfaceLaw(object(), TS, ORTHO, h0=0.0)
     with pytest.raises(ValueError, match="p_seat"):
         law.with_seating(-1.0)
+
+    class NoInverse:  # a normal law without p -> h: fine with h0, not with with_seating
+        evaluate = ExponentialNormal().evaluate
+
+    assert InterfaceLaw(NoInverse(), TS, ORTHO, h0=1e-3).evaluate(np.zeros((2, 3)), st).contact.all()
+    with pytest.raises(ValueError, match="separation_for_pressure"):
+        InterfaceLaw(NoInverse(), TS, ORTHO).with_seating(1.0)
     with pytest.raises(ValueError, match="n_pts"):
         law.initial_state(-1)
