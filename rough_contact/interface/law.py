@@ -24,7 +24,7 @@ import numpy as np
 
 from ..validation import check_scalar
 from .contract import LawResult, check_jump
-from .friction import IsotropicSlipHardening, OrthotropicSlipHardening, _Columns, _norm
+from .friction import FrictionInput, IsotropicSlipHardening, OrthotropicSlipHardening
 from .state import InterfaceState
 from .tangential import TangentialStiffness
 
@@ -163,32 +163,31 @@ class InterfaceLaw:
         sp = committed.plastic_slip
         kap = committed.accumulated_slip
         if contact.all():  # work on views: no gather/scatter
-            cols = _Columns(jump[:, 1] - sp[:, 0], jump[:, 2] - sp[:, 1], cx * k, cy * k,
-                            cx * dk, cy * dk, p, k, kap[:, 0], kap[:, 1], committed.slip_path)
-            slip = self.friction._map(cols, traction[:, 1:], tangent[:, 1:, :])
-            pts = None if slip is None else slip.idx
+            pts_in = FrictionInput(jump[:, 1] - sp[:, 0], jump[:, 2] - sp[:, 1], cx * k, cy * k,
+                                   cx * dk, cy * dk, p, k, kap[:, 0], kap[:, 1],
+                                   committed.slip_path)
+            slip = self.friction.evaluate(pts_in, traction[:, 1:], tangent[:, 1:, :])
+            pts = slip.slip_index
         else:
             ic = np.flatnonzero(contact)
             kc, dkc = k.take(ic), dk.take(ic)
-            cols = _Columns(jump[ic, 1] - sp[ic, 0], jump[ic, 2] - sp[ic, 1], cx * kc, cy * kc,
-                            cx * dkc, cy * dkc, p.take(ic), kc, kap[ic, 0], kap[ic, 1],
-                            committed.slip_path.take(ic))
-            out_t = np.empty((ic.size, 2))
-            out_D = np.empty((ic.size, 2, 3))
-            slip = self.friction._map(cols, out_t, out_D)
-            traction[ic, 1:] = out_t
-            tangent[ic, 1:, :] = out_D
-            pts = None if slip is None else ic.take(slip.idx)
+            pts_in = FrictionInput(jump[ic, 1] - sp[ic, 0], jump[ic, 2] - sp[ic, 1], cx * kc,
+                                   cy * kc, cx * dkc, cy * dkc, p.take(ic), kc, kap[ic, 0],
+                                   kap[ic, 1], committed.slip_path.take(ic))
+            slip = self.friction.evaluate(pts_in)
+            traction[ic, 1:] = slip.traction
+            tangent[ic, 1:, :] = slip.tangent
+            pts = ic.take(slip.slip_index)
 
         state = committed.copy()
-        if slip is not None:
-            dspx, dspy = slip.dspx, slip.dspy
+        if pts.size:
+            dspx, dspy = slip.plastic_increment_x, slip.plastic_increment_y
             dw = traction[pts, 1] * dspx + traction[pts, 2] * dspy
             state.plastic_slip[pts, 0] += dspx
             state.plastic_slip[pts, 1] += dspy
             state.accumulated_slip[pts, 0] += np.abs(dspx)
             state.accumulated_slip[pts, 1] += np.abs(dspy)
-            state.slip_path[pts] += _norm(dspx, dspy)
+            state.slip_path[pts] += slip.path_increment
             dissipation[pts] = dw
             slipping[pts] = True
         return LawResult(traction, tangent, state, dissipation, a, contact, slipping)
