@@ -61,6 +61,7 @@ from typing import Optional, Tuple
 
 import numpy as np
 
+from ..validation import check_scalar
 from .contract import ConvergenceError
 
 __all__ = [
@@ -217,30 +218,17 @@ def _outputs(points: FrictionInput, traction, tangent):
 
 
 # ----------------------------------------------------------------------------- validation
-def _pair(name: str, value, lo: float, hi: float, lo_open: bool, hi_open: bool = True):
-    arr = np.asarray(value, dtype=float)
+def _pair(name: str, value, **bounds) -> Tuple[float, float]:
+    """(x, y) pair of parameters, each checked by ``check_scalar`` (a scalar applies to both)."""
+    try:
+        arr = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        arr = np.full(3, np.nan)  # not numeric: reported as not a pair below
     if arr.ndim == 0:
         arr = np.array([arr, arr], dtype=float)
     if arr.shape != (2,):
         raise ValueError(f"{name} must be a scalar or a pair (x, y), got {value!r}")
-    for axis, v in zip("xy", arr):
-        ok = (np.isfinite(v) and (v > lo if lo_open else v >= lo)
-              and (v < hi if hi_open else v <= hi))
-        if not ok:
-            lb = "(" if lo_open else "["
-            rb = ")" if hi_open else "]"
-            raise ValueError(f"{name}[{axis}] = {v!r} must lie in {lb}{lo}, {hi}{rb}")
-    return float(arr[0]), float(arr[1])
-
-
-def _scalar(name: str, value, lo: float, hi: float, lo_open: bool, hi_open: bool = True) -> float:
-    v = float(value)
-    ok = np.isfinite(v) and (v > lo if lo_open else v >= lo) and (v < hi if hi_open else v <= hi)
-    if not ok:
-        lb = "(" if lo_open else "["
-        rb = ")" if hi_open else "]"
-        raise ValueError(f"{name} = {value!r} must lie in {lb}{lo}, {hi}{rb}")
-    return v
+    return tuple(check_scalar(f"{name}[{axis}]", float(v), **bounds) for axis, v in zip("xy", arr))
 
 
 def _columns(elastic_slip, kt, dkt, pressure, kn, accumulated_slip, slip_path) -> FrictionInput:
@@ -457,18 +445,18 @@ class OrthotropicSlipHardening:
 
     def __post_init__(self) -> None:
         s = object.__setattr__
-        s(self, "mu_macro", _pair("mu_macro", self.mu_macro, 0.0, np.inf, True))
+        s(self, "mu_macro", _pair("mu_macro", self.mu_macro, lo=0.0))
         s(self, "mu_initial_ratio",
-          _pair("mu_initial_ratio", self.mu_initial_ratio, 0.0, 1.0, True, hi_open=False))
-        s(self, "hardening", _pair("hardening", self.hardening, 0.0, np.inf, False))
+          _pair("mu_initial_ratio", self.mu_initial_ratio, lo=0.0, hi=1.0, hi_open=False))
+        s(self, "hardening", _pair("hardening", self.hardening, lo=0.0, lo_open=False, unit="1/mm"))
         if self.potential_axes is not None and self.potential_exponent is not None:
             raise ValueError("give either potential_axes or potential_exponent, not both")
         if self.potential_axes is not None:
             s(self, "potential_axes",
-              _pair("potential_axes", self.potential_axes, 0.0, np.inf, True))
+              _pair("potential_axes", self.potential_axes, lo=0.0))
         if self.potential_exponent is not None:
             s(self, "potential_exponent",
-              _scalar("potential_exponent", self.potential_exponent, -np.inf, np.inf, True))
+              check_scalar("potential_exponent", self.potential_exponent))
 
     # -- coefficients ---------------------------------------------------------------------
     def _mu(self, kapx, kapy):
@@ -574,7 +562,8 @@ class OrthotropicSlipHardening:
             sr = s.take(r)
             wyr = wy if np.isscalar(wy) else wy.take(r)
             ux, uy = sr.elastic_slip_x / wx, sr.elastic_slip_y / wyr
-            mx, _, my, _ = self._mu(sr.kappa_x + np.abs(sr.elastic_slip_x), sr.kappa_y + np.abs(sr.elastic_slip_y))
+            mx, _, my, _ = self._mu(sr.kappa_x + np.abs(sr.elastic_slip_x),
+                                    sr.kappa_y + np.abs(sr.elastic_slip_y))
             rtx, rty, dspx[r], dspy[r], D = _released(sr, ux, uy, mx, my)
             _write_slip(idx[r], out_t, out_D, rtx, rty, D)
         if not released.all():
@@ -661,10 +650,11 @@ class IsotropicSlipHardening:
 
     def __post_init__(self) -> None:
         s = object.__setattr__
-        s(self, "mu_macro", _scalar("mu_macro", self.mu_macro, 0.0, np.inf, True))
+        s(self, "mu_macro", check_scalar("mu_macro", self.mu_macro, lo=0.0))
         s(self, "mu_initial_ratio",
-          _scalar("mu_initial_ratio", self.mu_initial_ratio, 0.0, 1.0, True, hi_open=False))
-        s(self, "hardening", _scalar("hardening", self.hardening, 0.0, np.inf, False))
+          check_scalar("mu_initial_ratio", self.mu_initial_ratio, lo=0.0, hi=1.0, hi_open=False))
+        s(self, "hardening",
+          check_scalar("hardening", self.hardening, lo=0.0, lo_open=False, unit="1/mm"))
 
     def _mu(self, kap):
         return _hardening(self.mu_macro, self.mu_initial_ratio, self.hardening, kap)
@@ -736,7 +726,8 @@ class IsotropicSlipHardening:
             r = np.flatnonzero(released)
             sr = s.take(r)
             mr, _ = self._mu(sr.slip_path + np.hypot(sr.elastic_slip_x, sr.elastic_slip_y))
-            rtx, rty, dspx[r], dspy[r], D = _released(sr, sr.elastic_slip_x, sr.elastic_slip_y, mr, mr)
+            rtx, rty, dspx[r], dspy[r], D = _released(sr, sr.elastic_slip_x, sr.elastic_slip_y,
+                                                      mr, mr)
             _write_slip(idx[r], out_t, out_D, rtx, rty, D)
         if not released.all():
             g = np.flatnonzero(~released) if released.any() else slice(None)

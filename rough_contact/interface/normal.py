@@ -58,6 +58,8 @@ from typing import Callable, Optional, Tuple
 
 import numpy as np
 
+from ..validation import check_scalar
+
 __all__ = ["NormalLaw"]
 
 Model = Callable[[np.ndarray], Tuple[np.ndarray, np.ndarray, np.ndarray]]
@@ -73,23 +75,8 @@ _BLOCK = 4096
 # ----------------------------------------------------------------------------------------------
 # validation helpers
 # ----------------------------------------------------------------------------------------------
-def _positive_scalar(name: str, value, allow_zero: bool = False) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a real number, got {value!r}") from None
-    ok = np.isfinite(v) and (v >= 0.0 if allow_zero else v > 0.0)
-    if not ok:
-        rng = "[0, inf)" if allow_zero else "(0, inf)"
-        raise ValueError(f"{name} = {value!r} is outside the valid range {rng}")
-    return v
-
-
 def _check_rtol(rtol) -> float:
-    r = _positive_scalar("rtol", rtol)
-    if not (1e-12 <= r <= 0.1):
-        raise ValueError(f"rtol = {rtol!r} is outside the valid range [1e-12, 0.1]")
-    return r
+    return check_scalar("rtol", rtol, lo=1e-12, hi=0.1, lo_open=False, hi_open=False)
 
 
 def _model_values(model: Model, h: np.ndarray) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -520,13 +507,9 @@ class NormalLaw:
     def _from_population(cls, fn, surface, param, rtol, area_limit, depth, tail, kwargs, name,
                          check):
         rtol = _check_rtol(rtol)
-        area_limit = _positive_scalar("area_limit", area_limit)
-        if area_limit >= 1.0:
-            raise ValueError(f"area_limit = {area_limit!r} is outside the valid range (0, 1)")
-        depth = _positive_scalar("depth", depth, allow_zero=True)
-        tail = _positive_scalar("tail", tail)
-        if tail >= 1e-2:
-            raise ValueError(f"tail = {tail!r} is outside the valid range (0, 1e-2)")
+        area_limit = check_scalar("area_limit", area_limit, lo=0.0, hi=1.0)
+        depth = check_scalar("depth", depth, lo=0.0, lo_open=False)
+        tail = check_scalar("tail", tail, lo=0.0, hi=1e-2)
 
         calls = [0]
 
@@ -607,7 +590,7 @@ class NormalLaw:
         """
         from rough_contact import population
 
-        _positive_scalar("E_star", E_star)
+        check_scalar("E_star", E_star, lo=0.0, unit="MPa")
         return cls._from_population(population.elastic, surface, E_star, rtol, area_limit,
                                     depth, tail, model_kwargs, "elastic", check)
 
@@ -639,7 +622,7 @@ class NormalLaw:
         """
         from rough_contact import population
 
-        _positive_scalar("E_star", E_star)
+        check_scalar("E_star", E_star, lo=0.0, unit="MPa")
         return cls._from_population(population.greenwood_williamson, surface, E_star, rtol,
                                     area_limit, depth, tail, model_kwargs, "greenwood_williamson",
                                     check)
