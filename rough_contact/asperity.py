@@ -24,8 +24,8 @@ elasto-plastic mean pressure (75); ``ch = 0.967`` is the fully plastic pressure 
 (66); ``omega_p/omega_c = 45``. The hardness H and yield strength Y are related either as
 the user gives them, or (when only one is given) by the paper's conventions: from H,
 ``K_Y Y = (2/pi) H`` (the only reading under which the paper's nondimensional critical
-interference (74)/(87) follows from (65), (69), (70); see EQUATIONS.md); from Y, Tabor's
-``Y = 0.354 H`` (68).
+interference (74)/(87) follows from (65), (69), (70); see ``docs/equations.md``); from Y,
+Tabor's ``Y = 0.354 H`` (68).
 """
 from __future__ import annotations
 

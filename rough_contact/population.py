@@ -1,9 +1,9 @@
 """Sums over the summit population: real area, load and stiffness vs separation.
 
 Implements the elastic model (52)-(55), the elasto-plastic model (78)-(85) with the exact
-stiffness -dW/dh (the Leibniz form of (88) corrected as in EQUATIONS.md: a boundary term at
-omega_c where the asperity load jumps), the bearing areas AG (24) and AB (25), and McCool's
-equivalent Greenwood-Williamson model (the "GW" columns of Tables 1-2).
+stiffness -dW/dh (the Leibniz form of (88), corrected as ``docs/equations.md`` explains: a
+boundary term at omega_c where the asperity load jumps), the bearing areas AG (24) and AB
+(25), and McCool's equivalent Greenwood-Williamson model (the "GW" columns of Tables 1-2).
 
 Units: separation h of the mean planes in mm; pressures W/A0 in MPa; stiffness per nominal
 area k_N = -d(W/A0)/dh in MPa/mm; area fractions A/A0 dimensionless.

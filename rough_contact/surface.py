@@ -5,7 +5,7 @@ The surface is described by five spectral moments (Bush, Gibson & Keogh; eqs 7-1
 the grain) and ``m40, m04`` (mean-square curvatures). From them follow the bandwidths (10-11),
 the summit density (17), the joint summit pdf (18), the mean summit curvature (70), the
 summit-height standard deviation (71-72), the summit mean-plane offset (73) and the plasticity
-index (69). Readings of misprinted equations follow ``EQUATIONS.md`` (see each property).
+index (69). Misprinted equations are read as stated in ``docs/equations.md`` (see each property).
 
 Units. The whole package works in **mm, N, MPa**. At the API boundary the moments are
 accepted in the paper's micrometre convention (``unit="um"``: m00 in um^2, m20/m02
@@ -187,7 +187,7 @@ def plasticity_index(surface: SpectralMoments, E_star: float, H: float) -> float
 
 
 def psum(w1, w4, w6, beta1: float, beta2: float):
-    """Joint pdf of summit height and curvatures, eq (18) as read in EQUATIONS.md.
+    """Joint pdf of summit height and curvatures, eq (18) as read in ``docs/equations.md``.
 
     psum = mu^2/sqrt(2 pi) w4 w6 exp(-X/2),
     X = (w1 - sqrt(beta1) w4 - sqrt(beta2) w6)^2 + mu (w4^2 + w6^2),

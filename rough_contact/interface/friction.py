@@ -24,7 +24,7 @@ Isotropic model, paper section 8.2
 (119) mu_F = mu_m [1 - (1 - beta) exp(-n kappa)], kappa = effective plastic slip (path length),
 (120) f = ||t_T|| - mu_F p,  (121) circular potential (slip coaxial with the traction).
 
-Decisions (documented in the README):
+Decisions (documented in ``docs/equations.md``):
     * Elastic part in TOTAL form: t_T = K_T(h) (s - s_p), K_T = diag(kTx, kTy), kT_i = c_i kN(h)
       (``tangential.TangentialStiffness``). On opening (kN -> 0) the elastic slip is released and
       the plastic slip s_p is kept. The tangent therefore contains dK_T/dg = c_i dkN/dh.
@@ -50,8 +50,15 @@ Decisions (documented in the README):
       coupling to the normal jump through p(h) and kT(h); ``continuum_tangent`` gives the paper's
       (107)-(110) for comparison.
 
-Sign convention (see common.md): t = dpsi/djump, jump = (g, s_x, s_y), t_N = -p, so the friction
-traction t_T points along the elastic slip s - s_p (it resists the motion of the second body).
+Sign convention (the interface-law contract, ``rough_contact.interface.contract``):
+t = dpsi/djump, jump = (g, s_x, s_y), t_N = -p, so the friction traction t_T points along the
+elastic slip s - s_p (it resists the motion of the second body). ``docs/equations.md`` lists
+the readings of (89)-(131) used here.
+
+Entry points: ``evaluate(FrictionInput, traction=, tangent=) -> FrictionOutput`` is what the
+composed law (``rough_contact.interface.law.InterfaceLaw``) calls at every evaluation (shapes
+checked, values trusted, results written into the caller's arrays); ``return_map`` takes
+(m, 2) pairs, validates every value and returns a dense ``FrictionResult``.
 """
 
 from __future__ import annotations

@@ -7,7 +7,8 @@ The law follows the interface-law contract of ``rough_contact.interface.contract
 (n, x, y), jump [g, s_x, s_y] with g > 0 opening, t = dpsi/djump, algorithmic tangent, purity,
 failures). The mean-plane separation is h = h0 + g; t_N = -p(h) <= 0 and t_T = K_T(h) (s - s_p)
 limited by friction, with K_T = diag(c_x, c_y) kN(h); D[:, 0, 0] = kN(h).
-``docs/interface_law.md`` states the paper's equations these readings rest on.
+``docs/equations.md`` (section "Interface law") states the paper's equations these readings
+rest on.
 
 Layers: normal law (p, kN, A/A0, dkN/dh; any ``NormalLawProtocol``) -> tangential stiffness
 (kT = c kN) -> friction return map (only at points with p > 0). Open points (p == 0) carry no

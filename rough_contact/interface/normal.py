@@ -615,7 +615,7 @@ class NormalLaw:
     def greenwood_williamson(cls, surface, E_star: float, rtol: float = 1e-4, *,
                              area_limit: float = 0.3, depth: float = 3.0, tail: float = 1e-12,
                              check: str = "midpoint", **model_kwargs) -> "NormalLaw":
-        """Law of McCool's equivalent Greenwood-Williamson model (see EQUATIONS.md).
+        """Law of McCool's equivalent Greenwood-Williamson model (``docs/equations.md``).
 
         Args: as in :meth:`elastic`; **model_kwargs go to
         :func:`rough_contact.population.greenwood_williamson`.
