@@ -135,6 +135,7 @@ class LawResult:
         fields = (("traction", (n, 3), np.floating), ("tangent", (n, 3, 3), np.floating),
                   ("dissipation", (n,), np.floating), ("area_fraction", (n,), np.floating),
                   ("contact", (n,), np.bool_), ("slipping", (n,), np.bool_))
+        kind_names = {np.floating: "a floating-point dtype", np.bool_: "bool"}
         for name, shape, kind in fields:
             value = getattr(self, name)
             if not isinstance(value, np.ndarray):
@@ -145,7 +146,7 @@ class LawResult:
                                        f"needs {shape} for {n} points")
             if not np.issubdtype(value.dtype, kind):
                 raise LawContractError(f"LawResult.{name} has dtype {value.dtype}, the contract "
-                                       f"needs {np.dtype(kind).name}")
+                                       f"needs {kind_names[kind]}")
         if not isinstance(self.state, LawState):
             raise LawContractError(
                 f"LawResult.state ({type(self.state).__name__}) must have a plastic_slip array, "
