@@ -3,7 +3,11 @@
 This module is the hand-off between the pure-numpy laws (``rough_contact.interface``) and the
 finite-element layer (``rough_contact.fem.contact.ContactInterface``). A law written by a user
 plugs in by satisfying :class:`InterfaceLawProtocol` and returning :class:`LawResult`; nothing
-else is looked up on it. ``docs/writing_a_law.md`` walks through a complete user law.
+else is looked up on it. ``docs/writing_a_law.md`` states the contract in prose and walks
+through a complete user law. Pure module: numpy only.
+
+A law is called once per evaluation with ALL interface points of a rank, as arrays (batch
+first); a rank may own no point, so n = 0 must work and give empty arrays.
 
 Units: mm, N, MPa. Jumps and gaps [mm]; tractions and pressures [MPa]; stiffnesses per nominal
 area [MPa/mm]; dissipation per nominal area [N/mm] (= MPa mm).
@@ -17,24 +21,29 @@ At every interface point the FE layer builds an orthonormal frame (n, x, y):
 * y = n x x.
 
 ``jump`` (n_pts, 3) holds ``[g, s_x, s_y]``, the components of u_second - u_first in that frame
-(plus the initial gap for a rigid obstacle). g > 0 opens the interface.
+(plus the initial gap for a rigid obstacle). g > 0 opens the interface; s is the tangential
+slip.
 
 Traction and tangent
 --------------------
-The traction is energy-conjugate to the jump, ``t = dpsi/djump`` for the interface free energy
-psi, so in compression ``t_N = -p <= 0`` and the friction traction points along the elastic
-slip. The FE residual is ``R = int B^T t dA`` and the Jacobian ``int B^T D B dA`` with
-``D = dt/djump`` (n_pts, 3, 3) the ALGORITHMIC tangent of the discrete (backward-Euler) update,
-which is non-symmetric for non-associated friction. A wrong tangent costs Newton iterations but
-never changes a converged answer.
+``traction`` (n_pts, 3) = ``[t_N, t_x, t_y]`` is energy-conjugate to the jump,
+``t = dpsi/djump`` for the interface free energy psi per nominal area, so in compression
+``t_N = -p <= 0`` and the friction traction points along the elastic slip. The FE residual is
+``R = int B^T t dA`` and the Jacobian ``int B^T D B dA`` with ``D = dt/djump`` (n_pts, 3, 3)
+(row: traction component, column: jump component; ``D[:, 0, 0] = -dp/dg >= 0``), the
+ALGORITHMIC tangent of the discrete update the law computes, including the coupling of the
+friction traction to the normal jump; it is non-symmetric for friction. A wrong tangent costs
+Newton iterations but never changes a converged answer.
 
 History
 -------
 ``evaluate`` is a pure function of ``(jump, committed)``: it must never mutate ``committed``
 (SNES line searches evaluate trial points that are thrown away). It returns the trial state
-that the interface stores; the interface commits it once per converged increment and drops it
-on a cutback. The law reports the dissipation INCREMENT of the step, ``t_T . Delta s_p``
-per nominal area; the interface accumulates it (one place).
+(a :class:`LawState`, a new object) that the interface stores; the interface commits it once
+per converged increment and drops it on a cutback. The law reports the dissipation INCREMENT
+of the step, ``t_T . Delta s_p >= 0`` per nominal area; the owner of the history accumulates it
+(``ContactInterface``, or ``rough_contact.interface.state.StatePair`` at a material point),
+never the law.
 
 Failures
 --------
