@@ -3,6 +3,11 @@
 Units: separation h of the mean planes [mm], pressure p = W/A0 [MPa], normal stiffness per unit
 nominal area k = -dp/dh [MPa/mm], its derivative dk/dh [MPa/mm^2], real-area fraction a = A/A0 [-].
 
+:class:`NormalLaw` implements ``rough_contact.interface.law.SeatableNormalLaw``, the part of the
+interface law (``rough_contact.interface.contract``) that maps the separation h = h0 + g to the
+normal traction t_N = -p(h) and its tangent k(h). The population models and the readings of the
+paper's equations behind them are described in ``docs/equations.md``.
+
 The population integrals of :mod:`rough_contact.population` cost far too much to be evaluated at
 every facet quadrature point of every Newton iteration, so :class:`NormalLaw` replaces them by an
 interpolant built once per surface and material:
