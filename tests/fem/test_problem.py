@@ -223,11 +223,17 @@ def test_seating_spring_for_body_held_only_by_contact():
 # cutback
 # ----------------------------------------------------------------------------------------------
 class _GapState:
+    """History of StepLimitedPenalty: the committed normal jump (a LawState: no plastic slip)."""
+
     def __init__(self, g):
         self.g = g
+        self.plastic_slip = np.zeros((g.size, 2))
 
     def copy(self):
         return _GapState(self.g.copy())
+
+    def __len__(self):
+        return self.g.size
 
 
 class StepLimitedPenalty:
