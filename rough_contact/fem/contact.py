@@ -44,7 +44,7 @@ Units: mm, N, MPa. Positions and jumps [mm], tractions [MPa], forces [N], areas 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Optional, Sequence, Union
+from typing import Optional, Sequence, Tuple, Union
 
 import basix
 import numpy as np
@@ -68,7 +68,7 @@ from rough_contact.validation import check_scalar
 
 __all__ = ["ContactInterface", "InterfaceSummary", "PointFields"]
 
-RigidPlane = tuple  # (point (3,), unit normal (3,)) [mm]
+RigidPlane = Tuple[Sequence[float], Sequence[float]]  # (point (3,), unit normal (3,)) [mm]
 
 
 @dataclass(frozen=True)
@@ -237,13 +237,8 @@ class ContactInterface:
         rule = _FacetRule.create(V.mesh, degree)
         geo1 = _FacetGeometry(V, _owned_tagged_facets(facet_tags, first_tag, n_owned_facets,
                                                       self.comm))
-        xq, normal = self._first_surface(geo1, rule)
+        xq, normal, N1 = self._first_surface(geo1, rule)
         R = self._local_axes(xq, normal, grain, rigid_plane)
-        element = V.element.basix_element
-        phi = element.tabulate(0, rule.points.reshape(-1, 3))[0].reshape(
-            rule.points.shape[0], rule.nq, element.dim)
-        lf1 = geo1.local_facet
-        N1 = np.take_along_axis(phi[lf1], geo1.closure[lf1][:, None, :], axis=2)  # (n_f,nq,nc)
         if second_tag is None:
             N2 = nodes2 = None
             self.n_remote_partners = 0
@@ -259,10 +254,11 @@ class ContactInterface:
 
     # ------------------------------------------------------------------ set-up steps
     def _first_surface(self, geo1: _FacetGeometry, rule: _FacetRule):
-        """Quadrature points, area weights and unit normals of the first surface (local).
+        """Quadrature points, area weights, unit normals and basis values on the first surface.
 
         Returns:
-            xq: (n_f, nq, 3) physical points [mm]; normal: (n_f, nq, 3) outward unit normals.
+            xq: (n_f, nq, 3) physical points [mm]; normal: (n_f, nq, 3) outward unit normals;
+            N1: (n_f, nq, n_close) values of the facet-closure basis functions at the points.
         """
         n_f, nq = geo1.facets.size, rule.nq
         self.n_facets, self.n_qp = n_f, nq
@@ -284,7 +280,10 @@ class ContactInterface:
         normal = sign[..., None] * nvec / dA[..., None]
         self._weights = (rule.weights[None, :] * dA).reshape(-1)
         self._x = xq.reshape(-1, 3)
-        return xq, normal
+        element = self.V.element.basix_element
+        phi = element.tabulate(0, rule.points.reshape(-1, 3))[0].reshape(n_lf, nq, element.dim)
+        N1 = np.take_along_axis(phi[lf1], geo1.closure[lf1][:, None, :], axis=2)
+        return xq, normal, N1
 
     def _local_axes(self, xq: np.ndarray, normal: np.ndarray, grain: np.ndarray,
                     rigid_plane: Optional[RigidPlane]) -> np.ndarray:

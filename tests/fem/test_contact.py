@@ -331,6 +331,14 @@ def test_errors():
         ContactInterface(V, tags, LOWER_TOP, UPPER_TOP, law=law)
     with pytest.raises(ValueError, match="grain_direction"):
         ContactInterface(V, tags, LOWER_TOP, UPPER_BOTTOM, law=law, grain_direction=(0, 0, 1))
+    with pytest.raises(ValueError, match="quadrature_degree = 1.5 is invalid"):
+        ContactInterface(V, tags, LOWER_TOP, UPPER_BOTTOM, law=law, quadrature_degree=1.5)
+    with pytest.raises(ValueError, match="quadrature_degree = -1 is invalid"):
+        ContactInterface(V, tags, LOWER_TOP, UPPER_BOTTOM, law=law, quadrature_degree=-1)
+    with pytest.raises(ValueError, match="match_tolerance = 0.0 is invalid"):
+        ContactInterface(V, tags, LOWER_TOP, UPPER_BOTTOM, law=law, match_tolerance=0.0)
+    with pytest.raises(ValueError, match="rigid_plane"):
+        ContactInterface(V, tags, LOWER_TOP, law=law, rigid_plane=(0.0, 0.0, 1.0))
 
     class NaNLaw:
         def initial_state(self, n):

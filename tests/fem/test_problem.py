@@ -68,6 +68,32 @@ def test_bad_input_raises():
         Material(-1.0, 0.3)
     with pytest.raises(ValueError, match="exactly one"):
         SurfaceLoad(1)
+    with pytest.raises(ValueError, match=r"SurfaceLoad\(tag=2\)\.force\[1\] = nan N is invalid"):
+        SurfaceLoad(2, force=[0.0, np.nan, 1.0])
+    with pytest.raises(ValueError, match=r"SurfaceLoad\(tag=2\)\.traction = \[1, 2\] is invalid"):
+        SurfaceLoad(2, traction=[1, 2])
+    scene = block_on_plane(lx=1.0, ly=1.0, h=1.0, mesh_size=0.6, order=1)
+    V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", 1))
+    with pytest.raises(ValueError, match=r"seating_stiffness = -1.0 MPa/mm is invalid: it must "
+                                         r"be finite and >= 0"):
+        ContactProblem(V, Material(E, NU), seating_stiffness=-1.0)
+    with pytest.raises(TypeError, match="interface must be a ContactInterface or None, got dict"):
+        ContactProblem(V, Material(E, NU), interface={})
+    problem = ContactProblem(V, Material(E, NU))
+    solver = SNESSolver(problem, prefix="test_bad_")
+    from rough_contact.solver.loading import load_path, load_unload_factors
+
+    for kwargs, message in (({"min_increment": 0.0}, "min_increment = 0.0 is invalid"),
+                            ({"max_growth": 0.5}, "max_growth = 0.5 is invalid"),
+                            ({"factors": [0.5, np.inf]}, "load factor 1 of the load path")):
+        args = dict(factors=[0.5], verbose=False) | kwargs
+        with pytest.raises(ValueError, match=message):
+            list(load_path(problem, solver, **args))
+    with pytest.raises(ValueError, match="n_load = 2.5 is invalid"):
+        load_unload_factors(2.5)
+    with pytest.raises(ValueError, match="final_factor = 1.0 is invalid"):
+        load_unload_factors(4, final_factor=1.0)
+    solver.destroy()
 
 
 # ----------------------------------------------------------------------------------------------
