@@ -94,7 +94,8 @@ class SurfaceLoad:
             check_scalar(f"SurfaceLoad(tag={self.tag}).{name}[{i}]", value, unit=unit)
 
 
-def rigid_body_modes(V: fem.FunctionSpace, cell_groups: Sequence[np.ndarray] = ()) -> PETSc.NullSpace:
+def rigid_body_modes(V: fem.FunctionSpace,
+                     cell_groups: Sequence[np.ndarray] = ()) -> PETSc.NullSpace:
     """Near-nullspace of 3D elasticity for algebraic multigrid (GAMG).
 
     Args:
@@ -217,7 +218,8 @@ class ContactProblem:
                 fem.assemble_scalar(fem.form(fem.Constant(msh, 1.0) * ds(load.tag))), op=MPI.SUM
             )
             if area <= 0.0:
-                raise ValueError(f"surface load tag {load.tag}: tagged area is {area} mm^2, must be > 0")
+                raise ValueError(f"surface load tag {load.tag}: tagged area = {area} mm^2 is "
+                                 "invalid: it must be > 0")
             if load.force is not None:
                 t = np.asarray(load.force, dtype=float) / area
             else:
@@ -255,7 +257,8 @@ class ContactProblem:
                                               lo_open=False, unit="MPa/mm")
         self.M_seat = None
         if seating_tag is not None and self.seating_stiffness > 0.0:
-            m = fem.form(fem.Constant(msh, self.seating_stiffness) * ufl.inner(u, v) * ds(seating_tag))
+            k_seat = fem.Constant(msh, self.seating_stiffness)
+            m = fem.form(k_seat * ufl.inner(u, v) * ds(seating_tag))
             # On the pattern of K (a superset), so it can be added with SAME_NONZERO_PATTERN.
             self.M_seat = self.K.duplicate(copy=False)
             self.M_seat.zeroEntries()

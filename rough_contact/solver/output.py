@@ -176,9 +176,9 @@ class ResultWriter:
                 if key == "__geometry__":
                     lines.append(f'        <Geometry GeometryType="XYZ">{item}</Geometry>')
                 else:
-                    kind = "Scalar" if len(shape) == 1 else ("Vector" if shape[1] == 3 else "Matrix")
-                    if len(shape) == 2 and shape[1] == 2:
-                        kind = "Matrix"
+                    # (n,) scalar, (n, 3) vector, anything else (e.g. (n, 2)) a matrix
+                    kind = "Scalar" if len(shape) == 1 else (
+                        "Vector" if shape[1] == 3 else "Matrix")
                     lines.append(f'        <Attribute Name="{key}" AttributeType="{kind}" '
                                  f'Center="Node">{item}</Attribute>')
             lines.append("      </Grid>")
@@ -205,7 +205,10 @@ class ResultWriter:
         atomic_write(self.csv_path, text.getvalue())
 
     def write(self, inc, extra: Optional[dict] = None) -> None:
-        """Write increment ``inc`` (an :class:`~rough_contact.solver.loading.Increment`). Collective."""
+        """Write increment ``inc`` (a :class:`~rough_contact.solver.loading.Increment`).
+
+        Collective.
+        """
         t = float(inc.step)
         if self.u is not None:
             self._write_displacement(t)

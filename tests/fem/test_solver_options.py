@@ -130,7 +130,8 @@ def test_bad_arguments():
     problem = bulk_problem(10.0)
     with pytest.raises(ValueError, match="prefix"):
         SNESSolver(problem, prefix="nounderscore")
-    with pytest.raises(ValueError, match=r"dof_threshold = -1 is invalid: it must be finite and >= 0"):
+    with pytest.raises(ValueError, match="dof_threshold = -1 is invalid: it must be finite and "
+                                         ">= 0"):
         SNESSolver(problem, prefix="bad_", dof_threshold=-1)
     with pytest.raises(ValueError, match="load factor = nan"):
         problem.set_load_factor(np.nan)
