@@ -156,6 +156,10 @@ class ContactProblem:
         quadrature_degree: optional quadrature degree for the bulk forms.
         body_cells: local cell indices of each disconnected body (one array per body), for a
             near-nullspace built per body; empty = the six global rigid-body modes.
+
+    Raises:
+        TypeError: ``interface`` is neither a ContactInterface nor None.
+        ValueError: bad materials, loads or seating stiffness (naming the quantity).
     """
 
     def __init__(
