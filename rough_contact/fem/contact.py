@@ -1,7 +1,8 @@
 """Contact interface operator: facet pairing, facet quadrature, jump kinematics, assembly.
 
 DOLFINx 0.5.2 has no external operators and cannot evaluate quadrature coefficients on facets,
-so the interface terms are assembled by hand (see ``/work/shared/DESIGN.md``):
+so the interface terms are assembled by hand; ``docs/design.md`` describes the design and the
+stack facts it relies on:
 
 * set-up (once): for every owned facet of the FIRST contact surface, its facet quadrature
   points mapped into the reference cell, the area weights and normals from the geometry map,
@@ -15,11 +16,21 @@ so the interface terms are assembled by hand (see ``/work/shared/DESIGN.md``):
   (wherever they are owned), the jump at all points is one batched matmul, the law is called ONCE,
   and the element vectors B^T t w and matrices B^T D B w are added with global indices.
 
-Conventions (contract of ``rough_contact.interface.law``): n is the unit normal of the first
-surface pointing towards the second body, x is the grain direction projected on the facet,
-y = n x x. jump = [g, s_x, s_y] are the local components of u_second - u_first (g > 0 opens).
-The law returns t = dpsi/djump; the residual contribution is R = int B^T t dA and the tangent
+The law is any :class:`~rough_contact.interface.contract.InterfaceLawProtocol`; its history
+lives in one :class:`~rough_contact.interface.state.StatePair` (``ContactInterface.history``),
+committed once per converged increment and reverted on a cutback.
+
+Conventions (``rough_contact.interface.contract``): n is the unit normal of the first surface
+pointing towards the second body, x is the grain direction projected on the facet, y = n x x.
+jump = [g, s_x, s_y] are the local components of u_second - u_first (g > 0 opens). The law
+returns t = dpsi/djump; the residual contribution is R = int B^T t dA and the tangent
 int B^T (dt/djump) B dA. The force the interface exerts on the first body is int R_loc^T t dA.
+
+Failures: a non-finite jump (checked before the law is called), a non-finite traction or
+tangent and a law's own :class:`~rough_contact.interface.contract.ConvergenceError` raise
+``ConvergenceError`` on every rank (the load stepping cuts back); any other exception of the
+law propagates with its type on the failing rank and as a ``RuntimeError`` naming it on the
+others (:func:`rough_contact.fem.collective.raise_on_all_ranks`).
 
 Rigid obstacle (``second_tag=None``): u_second = 0. With ``rigid_plane=(point, normal)``
 (``normal`` = unit normal of the plane pointing towards the first body) the local normal is
@@ -33,7 +44,7 @@ Units: mm, N, MPa. Positions and jumps [mm], tractions [MPa], forces [N], areas 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Sequence
+from typing import Optional, Sequence, Tuple, Union
 
 import basix
 import numpy as np
@@ -44,31 +55,54 @@ from scipy.spatial import cKDTree
 import dolfinx
 import dolfinx.cpp
 import dolfinx.fem
+from rough_contact.fem.collective import raise_on_all_ranks
+from rough_contact.interface.contract import (
+    ConvergenceError,
+    InterfaceLawProtocol,
+    LawContractError,
+    LawResult,
+    LawState,
+)
+from rough_contact.interface.state import StatePair
+from rough_contact.validation import check_scalar
 
-__all__ = ["ContactInterface", "PointFields", "SlipStats"]
+__all__ = ["ContactInterface", "InterfaceSummary", "PointFields"]
+
+RigidPlane = Tuple[Sequence[float], Sequence[float]]  # (point (3,), unit normal (3,)) [mm]
 
 
 @dataclass(frozen=True)
-class SlipStats:
-    """Global (all-rank) counts and extremes at the interface quadrature points.
+class InterfaceSummary:
+    """Global (all-rank) figures of the interface, identical on every rank.
+
+    Contact, slip, force and areas are those of the last evaluation; the dissipation is the
+    committed one (summed over converged increments).
 
     Attributes:
         n_points: number of interface quadrature points.
         n_contact: points with p > 0.
         n_slipping: points where the friction limit is active.
+        contact_force: (3,) force on the FIRST body's surface in global axes [N].
+        real_area: real contact area int A/A0 dA [mm^2].
+        nominal_area: area of the first contact surface [mm^2].
         contact_area: nominal area of the points in contact [mm^2].
         slipping_area: nominal area of the slipping points [mm^2].
         max_slip: largest |(s_x, s_y)| [mm].
-        max_plastic_slip: largest |plastic slip| [mm] (0 if the law stores none).
+        max_plastic_slip: largest |plastic slip| of the trial state [mm].
+        dissipation: committed accumulated frictional dissipation int D dA [N mm].
     """
 
     n_points: int
     n_contact: int
     n_slipping: int
+    contact_force: np.ndarray
+    real_area: float
+    nominal_area: float
     contact_area: float
     slipping_area: float
     max_slip: float
     max_plastic_slip: float
+    dissipation: float
 
 
 @dataclass(frozen=True)
@@ -81,7 +115,7 @@ class PointFields:
         area_fraction: (n,) A/A0 [-].
         gap: (n,) normal jump g [mm].
         slip: (n, 2) tangential jump (s_x, s_y) [mm].
-        plastic_slip: (n, 2) [mm] (zeros if the law's state has no ``plastic_slip``).
+        plastic_slip: (n, 2) plastic slip of the trial state [mm].
         dissipation: (n,) committed accumulated dissipation per area [N/mm].
         contact: (n,) bool.
         slipping: (n,) bool.
@@ -158,121 +192,115 @@ class ContactInterface:
         facet_tags: MeshTags on facets.
         first_tag: tag of the first contact surface (its normal defines the local axes).
         second_tag: tag of the conforming second surface, or None for a rigid obstacle.
-        law: interface law with ``initial_state(n)`` and ``evaluate(jump, committed)``.
+        law: the interface law (:class:`~rough_contact.interface.contract.InterfaceLawProtocol`:
+            ``initial_state(n)`` and ``evaluate(jump, committed) -> LawResult``).
         rigid_plane: for ``second_tag=None``: (point (3,), unit normal (3,) pointing towards the
-            first body) [mm], or an object with ``point`` and ``normal`` attributes; None = a
-            plane tangent to the first surface at every point.
+            first body) [mm]; None = a plane tangent to the first surface at every point.
         grain_direction: (3,) global direction projected on the facet to give the local x axis.
-        quadrature_degree: degree of the facet quadrature rule.
+        quadrature_degree: degree (integer >= 0) of the facet quadrature rule.
         bcs: Dirichlet conditions whose DOFs the interface must not touch (also
             ``set_dirichlet_dofs``).
-        match_tolerance: vertex matching tolerance relative to the facet size [-].
+        match_tolerance: vertex matching tolerance relative to the facet size [-], > 0.
+
+    Attributes:
+        history: committed and trial law state and the accumulated dissipation
+            (:class:`~rough_contact.interface.state.StatePair`).
+        n_points, n_points_global: interface quadrature points on this rank / on all ranks.
 
     Raises:
+        TypeError: ``law`` does not satisfy the protocol (names the missing methods).
+        LawContractError: ``law.initial_state`` returns no valid ``LawState``.
         ValueError: unknown/empty tags, unsupported spaces, surfaces that do not match.
     """
 
     def __init__(
         self,
-        V,
+        V: dolfinx.fem.FunctionSpace,
         facet_tags,
         first_tag: int,
-        second_tag: int | None = None,
+        second_tag: Optional[int] = None,
         *,
-        law: Any,
-        rigid_plane: Any = None,
+        law: InterfaceLawProtocol,
+        rigid_plane: Optional[RigidPlane] = None,
         grain_direction: Sequence[float] = (1.0, 0.0, 0.0),
         quadrature_degree: int = 2,
-        bcs: Sequence[Any] = (),
+        bcs: Sequence[dolfinx.fem.DirichletBCMetaClass] = (),
         match_tolerance: float = 1e-6,
     ):
-        msh = V.mesh
-        comm = msh.comm
-        self.comm = comm
+        self.comm = V.mesh.comm
         self.V = V
         self.law = law
-        tdim = msh.topology.dim
-        if tdim != 3 or msh.topology.cell_type not in _CELLS:
-            raise ValueError(
-                "ContactInterface needs a tetrahedral or hexahedral 3D mesh, got "
-                f"{msh.topology.cell_type}"
-            )
-        bs = V.dofmap.index_map_bs
-        element = V.element.basix_element
-        if bs != 3 or element.degree not in (1, 2) or element.family != basix.ElementFamily.P:
-            raise ValueError(
-                f"V must be a vector Lagrange space of degree 1 or 2 with 3 components, got "
-                f"block size {bs}, degree {element.degree}"
-            )
-        if V.element.needs_dof_transformations:
-            raise ValueError("V needs DOF transformations on facets (degree >= 3): not supported")
-        if msh.geometry.cmap.degree not in (1, 2):
-            raise ValueError(f"geometry degree {msh.geometry.cmap.degree} not supported (1 or 2)")
-        if second_tag is not None and second_tag == first_tag:
-            raise ValueError(f"first_tag and second_tag are both {first_tag}")
-        if second_tag is not None and rigid_plane is not None:
-            raise ValueError("give either second_tag or rigid_plane, not both")
-        if int(quadrature_degree) < 0:
-            raise ValueError(f"quadrature_degree = {quadrature_degree} must be >= 0")
-        grain = np.asarray(grain_direction, dtype=float)
-        if grain.shape != (3,) or not np.all(np.isfinite(grain)) or np.linalg.norm(grain) == 0:
-            raise ValueError(f"grain_direction = {grain_direction!r} must be a nonzero 3-vector")
+        grain, degree = _check_arguments(V, law, first_tag, second_tag, rigid_plane,
+                                         quadrature_degree, grain_direction, match_tolerance)
         self.first_tag, self.second_tag = first_tag, second_tag
+        n_owned_facets = _facet_connectivity(V.mesh)
+        rule = _FacetRule.create(V.mesh, degree)
+        geo1 = _FacetGeometry(V, _owned_tagged_facets(facet_tags, first_tag, n_owned_facets,
+                                                      self.comm))
+        xq, normal, N1 = self._first_surface(geo1, rule)
+        R = self._local_axes(xq, normal, grain, rigid_plane)
+        if second_tag is None:
+            N2 = nodes2 = None
+            self.n_remote_partners = 0
+        else:
+            N2, nodes2 = self._pair_second_surface(facet_tags, second_tag, n_owned_facets, geo1,
+                                                   rule, match_tolerance)
+        self._jump_operator(R, N1, geo1.global_nodes, N2, nodes2)
+        self._communication(bcs)
+        self.history = self._initial_history()
+        self._last_u = self._last = self._last_jump = None
+        self._cache_valid = False
+        self._result_checked = False  # the first evaluation's result is checked in full
 
-        msh.topology.create_connectivity(tdim - 1, tdim)
-        msh.topology.create_connectivity(tdim, tdim - 1)
-        n_owned_facets = msh.topology.index_map(tdim - 1).size_local
+    # ------------------------------------------------------------------ set-up steps
+    def _first_surface(self, geo1: _FacetGeometry, rule: _FacetRule):
+        """Quadrature points, area weights, unit normals and basis values on the first surface.
 
-        # ---- first surface: quadrature, geometry, basis -----------------------------------
-        facets1 = _owned_tagged_facets(facet_tags, first_tag, n_owned_facets, comm)
-        geo1 = _FacetGeometry(V, facets1)
-        n_f = facets1.size
-        cell = _basix_cell(msh)
-        facet_cell = _CELLS[msh.topology.cell_type][1]
-        ref_x = basix.geometry(cell)
-        ref_facets = np.array(basix.topology(cell)[2])  # (n_lf, nv)
-        xi, w_ref = basix.make_quadrature(facet_cell, int(quadrature_degree))
-        nq = w_ref.size
+        Returns:
+            xq: (n_f, nq, 3) physical points [mm]; normal: (n_f, nq, 3) outward unit normals;
+            N1: (n_f, nq, n_close) values of the facet-closure basis functions at the points.
+        """
+        n_f, nq = geo1.facets.size, rule.nq
         self.n_facets, self.n_qp = n_f, nq
-        # vertex weights of the facet points: barycentric (triangle) or bilinear (quadrilateral).
-        # A point of the shared surface has the same weights on both sides (up to the vertex
-        # permutation), so they carry the partner's reference coordinates exactly.
-        lam = _vertex_weights(facet_cell, xi)  # (nq, nv)
-        nv = lam.shape[1]
-        n_lf = ref_facets.shape[0]
-        fv_ref = ref_x[ref_facets]  # (n_lf, nv, 3)
-        X_lf = np.einsum("qi,fid->fqd", lam, fv_ref)  # (n_lf, nq, 3) points per local facet
-        T_lf = np.stack([fv_ref[:, 1] - fv_ref[:, 0], fv_ref[:, 2] - fv_ref[:, 0]], axis=2)
-        N_lf = basix.cell.facet_outward_normals(cell)  # (n_lf, 3)
-
-        cmap_el = _cmap_element(msh)
-        tab_g = cmap_el.tabulate(1, X_lf.reshape(-1, 3)).reshape(4, n_lf, nq, cmap_el.dim)
+        cmap_el = _cmap_element(self.V.mesh)
+        n_lf = rule.points.shape[0]
+        tab_g = cmap_el.tabulate(1, rule.points.reshape(-1, 3)).reshape(4, n_lf, nq, cmap_el.dim)
         lf1 = geo1.local_facet
         phi_g = tab_g[0][lf1]  # (n_f, nq, n_gdof)
         dphi_g = np.moveaxis(tab_g[1:], 0, -1)[lf1]  # (n_f, nq, n_gdof, 3)
         xq = np.einsum("fqk,fki->fqi", phi_g, geo1.cell_nodes_x)
         J = np.einsum("fki,fqkd->fqid", geo1.cell_nodes_x, dphi_g)  # (n_f, nq, 3, 3)
-        t12 = np.einsum("fqid,fde->fqie", J, T_lf[lf1])  # (n_f, nq, 3, 2)
+        t12 = np.einsum("fqid,fde->fqie", J, rule.tangents[lf1])  # (n_f, nq, 3, 2)
         nvec = np.cross(t12[..., 0], t12[..., 1])
         dA = np.linalg.norm(nvec, axis=-1)
         # physical outward direction J^-T N_ref fixes the sign of t1 x t2
-        n_ref = np.broadcast_to(N_lf[lf1][:, None, :, None], J.shape[:-1] + (1,))
+        n_ref = np.broadcast_to(rule.normals[lf1][:, None, :, None], J.shape[:-1] + (1,))
         outward = np.linalg.solve(np.swapaxes(J, -1, -2), n_ref)[..., 0]
         sign = np.sign(np.einsum("fqi,fqi->fq", nvec, outward))
         normal = sign[..., None] * nvec / dA[..., None]
-        self._weights = (w_ref[None, :] * dA).reshape(-1)
+        self._weights = (rule.weights[None, :] * dA).reshape(-1)
         self._x = xq.reshape(-1, 3)
+        element = self.V.element.basix_element
+        phi = element.tabulate(0, rule.points.reshape(-1, 3))[0].reshape(n_lf, nq, element.dim)
+        N1 = np.take_along_axis(phi[lf1], geo1.closure[lf1][:, None, :], axis=2)
+        return xq, normal, N1
 
-        # local axes (n, x, y)
-        jump0 = np.zeros((n_f, nq, 3))
-        if second_tag is None and rigid_plane is not None:
+    def _local_axes(self, xq: np.ndarray, normal: np.ndarray, grain: np.ndarray,
+                    rigid_plane: Optional[RigidPlane]) -> np.ndarray:
+        """Local frames (n, x, y) per point and the initial gap to a rigid plane (collective).
+
+        Returns:
+            R: (n_f, nq, 3 local, 3 global) rows n, x, y.
+        """
+        jump0 = np.zeros(xq.shape)
+        if rigid_plane is not None:
             point, pnormal = _plane(rigid_plane)
             normal = np.broadcast_to(-pnormal, normal.shape).copy()
             jump0[..., 0] = (xq - point) @ pnormal
         gx = grain - np.einsum("fqi,i->fq", normal, grain)[..., None] * normal
         gnorm = np.linalg.norm(gx, axis=-1)
         bad = gnorm < 1e-6 * np.linalg.norm(grain)
-        n_bad = comm.allreduce(int(bad.sum()), op=MPI.SUM)
+        n_bad = self.comm.allreduce(int(bad.sum()), op=MPI.SUM)
         if n_bad:
             raise ValueError(
                 f"grain_direction {grain.tolist()} is (nearly) normal to the contact surface at "
@@ -280,73 +308,83 @@ class ContactInterface:
             )
         ex = gx / gnorm[..., None]
         ey = np.cross(normal, ex)
-        Rloc = np.stack([normal, ex, ey], axis=-2)  # (n_f, nq, 3 local, 3 global)
-        self._R = Rloc.reshape(-1, 3, 3)
+        R = np.stack([normal, ex, ey], axis=-2)  # (n_f, nq, 3 local, 3 global)
+        self._R = R.reshape(-1, 3, 3)
         self._jump0 = jump0.reshape(-1, 3)
+        return R
 
-        phi_u = element.tabulate(0, X_lf.reshape(-1, 3))[0].reshape(n_lf, nq, element.dim)
-        N1 = np.take_along_axis(phi_u[lf1], geo1.closure[lf1][:, None, :], axis=2)  # (n_f,nq,nc)
-        n_close = N1.shape[-1]
-        B1 = -np.einsum("fqac,fqk->fqakc", Rloc, N1).reshape(n_f, nq, 3, 3 * n_close)
-        nodes = geo1.global_nodes  # (n_f, n_close)
+    def _pair_second_surface(self, facet_tags, second_tag: int, n_owned_facets: int,
+                             geo1: _FacetGeometry, rule: _FacetRule, match_tolerance: float):
+        """Partner facets on the second surface, from an all-gathered copy of it (collective).
 
-        # ---- second surface: all-gathered facet data, matching, partner basis -------------
-        if second_tag is not None:
-            facets2 = _owned_tagged_facets(facet_tags, second_tag, n_owned_facets, comm)
-            geo2 = _FacetGeometry(V, facets2)
-            gathered = comm.allgather((geo2.vertex_x, geo2.local_facet, geo2.global_nodes))
-            owner2 = np.concatenate(
-                [np.full(g[1].size, r, dtype=np.int64) for r, g in enumerate(gathered)]
+        Returns:
+            N2: (n_f, nq, n_close) partner basis values at the points of the first facets.
+            nodes2: (n_f, n_close) global block indices of the partner's closure DOFs.
+        """
+        comm = self.comm
+        n_f, nq, nv = geo1.facets.size, rule.nq, rule.lam.shape[1]
+        element = self.V.element.basix_element
+        n_close = geo1.closure.shape[1]
+        geo2 = _FacetGeometry(self.V, _owned_tagged_facets(facet_tags, second_tag,
+                                                           n_owned_facets, comm))
+        gathered = comm.allgather((geo2.vertex_x, geo2.local_facet, geo2.global_nodes))
+        owner2 = np.concatenate(
+            [np.full(g[1].size, r, dtype=np.int64) for r, g in enumerate(gathered)]
+        )
+        vx2 = np.concatenate([g[0] for g in gathered]).reshape(-1, nv, 3)
+        lf2_all = np.concatenate([g[1] for g in gathered]).astype(np.int64)
+        nodes2_all = np.concatenate([g[2] for g in gathered]).reshape(-1, n_close)
+        vx1 = geo1.vertex_x  # (n_f, nv, 3)
+        size = np.linalg.norm(vx1[:, 1] - vx1[:, 0], axis=1) if n_f else np.zeros(0)
+        tol = match_tolerance * size
+        partner = np.zeros(n_f, dtype=np.int64)
+        ok = np.zeros(n_f, dtype=bool)
+        perm = np.zeros((n_f, nv), dtype=np.int64)
+        if n_f and vx2.shape[0]:
+            tree = cKDTree(vx2.mean(axis=1))
+            _, partner = tree.query(vx1.mean(axis=1), k=1)
+            d = np.linalg.norm(vx1[:, :, None, :] - vx2[partner][:, None, :, :], axis=-1)
+            perm = np.argmin(d, axis=2)  # first vertex i <-> partner vertex perm[i]
+            ok = (np.max(np.min(d, axis=2), axis=1) <= tol) & (
+                np.sort(perm, axis=1) == np.arange(nv)
+            ).all(axis=1)
+        n_bad = comm.allreduce(int(np.sum(~ok)), op=MPI.SUM)
+        if n_bad:
+            example = comm.allgather(vx1[~ok].mean(axis=1)[0].tolist() if np.any(~ok) else None)
+            example = next(e for e in example if e is not None)
+            n_total = comm.allreduce(n_f, op=MPI.SUM)
+            raise ValueError(
+                f"{n_bad} of {n_total} facets of contact surface {self.first_tag} have no "
+                f"matching facet on surface {second_tag} (vertex tolerance {match_tolerance} x "
+                f"facet size), e.g. the facet with centroid {example}; the interface must be "
+                "conforming (same surface mesh on both sides)"
             )
-            vx2 = np.concatenate([g[0] for g in gathered]).reshape(-1, nv, 3)
-            lf2_all = np.concatenate([g[1] for g in gathered]).astype(np.int64)
-            nodes2_all = np.concatenate([g[2] for g in gathered]).reshape(-1, n_close)
-            vx1 = geo1.vertex_x  # (n_f, nv, 3)
-            size = np.linalg.norm(vx1[:, 1] - vx1[:, 0], axis=1) if n_f else np.zeros(0)
-            tol = match_tolerance * size
-            partner = np.zeros(n_f, dtype=np.int64)
-            ok = np.zeros(n_f, dtype=bool)
-            perm = np.zeros((n_f, nv), dtype=np.int64)
-            if n_f and vx2.shape[0]:
-                tree = cKDTree(vx2.mean(axis=1))
-                _, partner = tree.query(vx1.mean(axis=1), k=1)
-                d = np.linalg.norm(vx1[:, :, None, :] - vx2[partner][:, None, :, :], axis=-1)
-                perm = np.argmin(d, axis=2)  # first vertex i <-> partner vertex perm[i]
-                ok = (np.max(np.min(d, axis=2), axis=1) <= tol) & (
-                    np.sort(perm, axis=1) == np.arange(nv)
-                ).all(axis=1)
-            n_bad = comm.allreduce(int(np.sum(~ok)), op=MPI.SUM)
-            if n_bad:
-                example = comm.allgather(vx1[~ok].mean(axis=1)[0].tolist() if np.any(~ok) else None)
-                example = next(e for e in example if e is not None)
-                n_total = comm.allreduce(n_f, op=MPI.SUM)
-                raise ValueError(
-                    f"{n_bad} of {n_total} facets of contact surface {first_tag} have no matching "
-                    f"facet on surface {second_tag} (vertex tolerance {match_tolerance} x facet "
-                    f"size), e.g. the facet with centroid {example}; the interface must be "
-                    "conforming (same surface mesh on both sides)"
-                )
-            lf2 = lf2_all[partner]
-            self.n_remote_partners = int(np.sum(owner2[partner] != comm.rank))
-            # barycentric reuse: the point with weights lam on the first facet's vertices
-            X2 = np.einsum(
-                "qi,fid->fqd", lam, fv_ref[lf2][np.arange(n_f)[:, None], perm]
-            )  # (n_f, nq, 3)
-            phi2 = (
-                element.tabulate(0, X2.reshape(-1, 3))[0].reshape(n_f, nq, element.dim)
-                if n_f
-                else np.zeros((0, nq, element.dim))
-            )
-            closure2 = geo1.closure[lf2]  # same element on both sides
-            N2 = np.take_along_axis(phi2, closure2[:, None, :], axis=2)
-            B2 = np.einsum("fqac,fqk->fqakc", Rloc, N2).reshape(n_f, nq, 3, 3 * n_close)
-            B = np.concatenate([B1, B2], axis=3)
-            nodes = np.concatenate([nodes, nodes2_all[partner]], axis=1)
-        else:
-            B = B1
-            self.n_remote_partners = 0
-        # pair DOFs in ascending global order (PETSc's row insertion is faster with sorted
-        # columns); B's columns follow
+        lf2 = lf2_all[partner]
+        self.n_remote_partners = int(np.sum(owner2[partner] != comm.rank))
+        # barycentric reuse: the point with weights lam on the first facet's vertices
+        X2 = np.einsum(
+            "qi,fid->fqd", rule.lam, rule.vertices[lf2][np.arange(n_f)[:, None], perm]
+        )  # (n_f, nq, 3)
+        phi2 = (
+            element.tabulate(0, X2.reshape(-1, 3))[0].reshape(n_f, nq, element.dim)
+            if n_f
+            else np.zeros((0, nq, element.dim))
+        )
+        closure2 = geo1.closure[lf2]  # same element on both sides
+        N2 = np.take_along_axis(phi2, closure2[:, None, :], axis=2)
+        return N2, nodes2_all[partner]
+
+    def _jump_operator(self, R: np.ndarray, N1: np.ndarray, nodes1: np.ndarray,
+                       N2: Optional[np.ndarray], nodes2: Optional[np.ndarray]) -> None:
+        """B per point: jump = B u_pair + jump0 in local axes, columns in ascending global DOF
+        order (PETSc inserts sorted columns faster), plus the per-facet views used by matmul."""
+        n_f, nq, n_close = N1.shape
+        B = -np.einsum("fqac,fqk->fqakc", R, N1).reshape(n_f, nq, 3, 3 * n_close)
+        nodes = nodes1  # (n_f, n_close)
+        if N2 is not None:
+            B2 = np.einsum("fqac,fqk->fqakc", R, N2).reshape(n_f, nq, 3, 3 * n_close)
+            B = np.concatenate([B, B2], axis=3)
+            nodes = np.concatenate([nodes, nodes2], axis=1)
         pair_dofs = (3 * nodes[:, :, None] + np.arange(3)).reshape(n_f, 3 * nodes.shape[1])
         order = np.argsort(pair_dofs, axis=1)
         pair_dofs = np.take_along_axis(pair_dofs, order, axis=1)
@@ -358,12 +396,13 @@ class ContactInterface:
         self._pair_nodes = nodes  # (n_f, n_nodes_pair) global block indices
         self._pair_dofs = pair_dofs  # (n_f, nd) global scalar DOFs
         self.n_points = n_f * nq
-        self.n_points_global = comm.allreduce(self.n_points, op=MPI.SUM)
+        self.n_points_global = self.comm.allreduce(self.n_points, op=MPI.SUM)
 
-        # ---- communication: one scatter for every DOF the owned facets touch -------------
+    def _communication(self, bcs) -> None:
+        """One scatter for every DOF the owned facets touch; Dirichlet rows masked (collective)."""
         self._uniq, inv = np.unique(self._pair_dofs, return_inverse=True)
         self._inv = inv.reshape(self._pair_dofs.shape)
-        template = dolfinx.cpp.la.petsc.create_vector(V.dofmap.index_map, 3)
+        template = dolfinx.cpp.la.petsc.create_vector(self.V.dofmap.index_map, 3)
         self._template = template
         self._loc = PETSc.Vec().createSeq(self._uniq.size, comm=MPI.COMM_SELF)
         is_from = PETSc.IS().createGeneral(self._uniq.astype(PETSc.IntType), comm=MPI.COMM_SELF)
@@ -371,14 +410,27 @@ class ContactInterface:
         self._rows = self._pair_dofs.astype(PETSc.IntType)
         self.set_dirichlet_dofs(None, bcs)
 
-        # ---- history --------------------------------------------------------------------
-        self.committed = law.initial_state(self.n_points)
-        self.trial = self.committed.copy()
-        self._diss_committed = np.zeros(self.n_points)
-        self._last_u = self._last = self._last_jump = None
-        self._cache_valid = self._committed_last = False
+    def _initial_history(self) -> StatePair:
+        """The law's virgin state, checked against the LawState contract (collective)."""
+        n = self.n_points
+        state, error = None, None
+        try:
+            state = self.law.initial_state(n)
+            if not isinstance(state, LawState):
+                raise LawContractError(
+                    f"{type(self.law).__name__}.initial_state returned "
+                    f"{type(state).__name__}, which lacks plastic_slip, copy() or __len__ "
+                    "(rough_contact.interface.contract.LawState)")
+            if len(state) != n or np.shape(state.plastic_slip) != (n, 2):
+                raise LawContractError(
+                    f"{type(self.law).__name__}.initial_state({n}) holds {len(state)} points "
+                    f"with plastic_slip of shape {np.shape(state.plastic_slip)}; the contract "
+                    f"needs {n} and ({n}, 2)")
+        except Exception as exc:  # noqa: BLE001 - re-raised on every rank just below
+            error = exc
+        raise_on_all_ranks(self.comm, error)
+        return StatePair(state)
 
-    # ------------------------------------------------------------------ set-up helpers
     def set_dirichlet_dofs(self, global_dofs: np.ndarray | None = None, bcs: Sequence[Any] = ()):
         """Mark DOFs the interface must not assemble into (collective).
 
@@ -482,12 +534,12 @@ class ContactInterface:
         return A
 
     # ------------------------------------------------------------------ evaluation
-    def _pair_values(self, u) -> np.ndarray:
-        x = u.vector if hasattr(u, "vector") else u
+    def _pair_values(self, u: Union[dolfinx.fem.Function, PETSc.Vec]) -> np.ndarray:
+        x = u if isinstance(u, PETSc.Vec) else u.vector
         self._scatter.scatter(x, self._loc, PETSc.InsertMode.INSERT, PETSc.ScatterMode.FORWARD)
         return self._loc.getArray(readonly=True)[self._inv]
 
-    def jump(self, u) -> np.ndarray:
+    def jump(self, u: Union[dolfinx.fem.Function, PETSc.Vec]) -> np.ndarray:
         """Local jump [g, s_x, s_y] (n_pts, 3) [mm] at displacement u (Function or PETSc Vec)."""
         return self._jump_of(self._pair_values(u))
 
@@ -495,39 +547,54 @@ class ContactInterface:
         # batched matmul per facet: (n_f, nq*3, nd) @ (n_f, nd, 1)
         return (self._Bf @ u_pair[:, :, None]).reshape(-1, 3) + self._jump0
 
-    def evaluate(self, u):
-        """Evaluate the law at u (collective); cached while u's pair values do not change."""
+    def evaluate(self, u: Union[dolfinx.fem.Function, PETSc.Vec]) -> LawResult:
+        """Evaluate the law at u (collective); cached while u's pair values do not change.
+
+        The law is called once per new u on all points of this rank; the trial state and the
+        dissipation increment go to ``history`` (committed by :meth:`commit`).
+
+        Raises:
+            ConvergenceError: on every rank, if any rank met a non-finite jump, a non-finite
+                traction or tangent, or a ConvergenceError of the law.
+            LawContractError: the first result breaks the contract (naming the field).
+            Exception: any other exception of the law, with its type on the failing rank and
+                as a RuntimeError naming it on the others.
+        """
         u_pair = self._pair_values(u)
         hit = self._cache_valid and np.array_equal(u_pair, self._last_u)
         if self.comm.allreduce(hit, op=MPI.LAND):  # ranks must agree: collectives follow
             return self._last
         jump = self._jump_of(u_pair)
-        error = None
+        res, error = None, None
         try:
-            res = self.law.evaluate(jump, self.committed)
+            self._check_finite("jump", jump, np.isfinite(jump).all(axis=1))
+            res = self.law.evaluate(jump, self.history.committed)
+            if not self._result_checked:
+                _check_result(self.law, res, self.n_points)
             finite = np.isfinite(res.traction).all(axis=1) & np.isfinite(res.tangent).all(
-                axis=(1, 2)
-            )
-        except (ValueError, ArithmeticError, RuntimeError) as exc:  # keep ranks in step: raise
-            # everywhere, below (a rank-local ReturnMappingError would otherwise hang the rest)
-            error, finite = str(exc), np.zeros(self.n_points, dtype=bool)
-        errors = [e for e in self.comm.allgather(error) if e is not None]
-        if errors:
-            raise ValueError(f"interface law failed: {errors[0]}")
-        n_bad = self.comm.allreduce(int(np.sum(~finite)), op=MPI.SUM)
-        if n_bad:
-            where = self._x[~finite][0].tolist() if np.any(~finite) else None
-            where = next(e for e in self.comm.allgather(where) if e is not None)
-            raise ValueError(
-                f"interface law returned non-finite traction/tangent at {n_bad} of "
-                f"{self.n_points_global} points, e.g. at x = {where} mm"
-            )
-        self.trial = res.state
+                axis=(1, 2))
+            self._check_finite("traction/tangent returned by the law", jump, finite)
+        except Exception as exc:  # noqa: BLE001 - re-raised on every rank just below
+            error = exc
+        raise_on_all_ranks(self.comm, error)
+        self._result_checked = True
+        self.history.update(res)
         self._last_u, self._last, self._last_jump = u_pair.copy(), res, jump
-        self._cache_valid, self._committed_last = True, False
+        self._cache_valid = True
         return res
 
-    def assemble_residual(self, u, b: PETSc.Vec) -> None:
+    def _check_finite(self, what: str, jump: np.ndarray, finite: np.ndarray) -> None:
+        """Raise ConvergenceError (this rank) if ``finite`` (n_pts,) is False somewhere: a
+        diverging global iterate, which a smaller load increment may cure."""
+        if finite.all():
+            return
+        bad = np.flatnonzero(~finite)
+        raise ConvergenceError(
+            f"non-finite {what} at {bad.size} of {self.n_points} interface points of rank "
+            f"{self.comm.rank}, e.g. at x = {self._x[bad[0]].tolist()} mm "
+            f"(jump {jump[bad[0]].tolist()} mm)")
+
+    def assemble_residual(self, u: Union[dolfinx.fem.Function, PETSc.Vec], b: PETSc.Vec) -> None:
         """Add int B^T t dA to b (global PETSc Vec of V's layout) and assemble b (collective)."""
         res = self.evaluate(u)
         tw = (res.traction * self._weights[:, None]).reshape(self.n_facets, 3 * self.n_qp, 1)
@@ -539,7 +606,7 @@ class ContactInterface:
         b.assemblyBegin()
         b.assemblyEnd()
 
-    def assemble_jacobian(self, u, A: PETSc.Mat) -> None:
+    def assemble_jacobian(self, u: Union[dolfinx.fem.Function, PETSc.Vec], A: PETSc.Mat) -> None:
         """Add int B^T D B dA to A (collective). Flushes A first; the caller calls A.assemble()."""
         res = self.evaluate(u)
         A.assemblyBegin(PETSc.Mat.AssemblyType.FLUSH)
@@ -552,7 +619,7 @@ class ContactInterface:
         A.setValuesRCV(rows, rows, K, addv=PETSc.InsertMode.ADD_VALUES)
 
     # ------------------------------------------------------------------ history
-    def commit(self, u=None) -> None:
+    def commit(self, u: Union[dolfinx.fem.Function, PETSc.Vec, None] = None) -> None:
         """Accept the trial state of the last evaluation (after a converged increment).
 
         Args:
@@ -560,21 +627,17 @@ class ContactInterface:
         """
         if u is not None:
             self.evaluate(u)
-        if self._last is not None and not self._committed_last:
-            self._diss_committed = self._diss_committed + self._last.dissipation
-            self.trial = self._last.state
-            self._committed_last = True
-        self.committed = self.trial.copy()
+        self.history.commit()
         self._cache_valid = False  # a new committed state: never reuse the old evaluation
 
     def revert(self) -> None:
         """Discard the trial state (failed increment, before a cutback)."""
-        self.trial = self.committed.copy()
+        self.history.revert()
         self._last = None
         self._cache_valid = False
 
     # ------------------------------------------------------------------ output
-    def _result(self):
+    def _result(self) -> LawResult:
         if self._last is None:
             raise ValueError("the interface has not been evaluated since the last commit/revert")
         return self._last
@@ -596,31 +659,38 @@ class ContactInterface:
 
     def dissipation(self) -> float:
         """Committed accumulated frictional dissipation int D dA [N mm] (collective)."""
-        return self.comm.allreduce(float(np.dot(self._diss_committed, self._weights)), op=MPI.SUM)
+        return self.comm.allreduce(float(np.dot(self.history.dissipated, self._weights)),
+                                   op=MPI.SUM)
 
-    def slip_stats(self) -> SlipStats:
-        """Counts and extremes of contact and slip at the last evaluation (collective)."""
+    def n_contact(self) -> int:
+        """Global number of points in contact (p > 0) at the last evaluation (collective, one
+        allreduce: cheap enough for every Jacobian)."""
+        return self.comm.allreduce(int(self._result().contact.sum()), op=MPI.SUM)
+
+    def summary(self) -> InterfaceSummary:
+        """Global figures after the last evaluation (collective: two allreduces)."""
         res = self._result()
-        c = self.comm
+        w = self._weights
+        force = np.einsum("pai,pa,p->i", self._R, res.traction, w)
+        sums = np.concatenate([force, [
+            float(np.dot(res.area_fraction, w)), float(w.sum()), float(w[res.contact].sum()),
+            float(w[res.slipping].sum()), float(np.dot(self.history.dissipated, w)),
+            float(res.contact.sum()), float(res.slipping.sum())]])
+        sums = self.comm.allreduce(sums, op=MPI.SUM)
         slip = np.linalg.norm(self._last_jump[:, 1:], axis=1)
-        ps = self._plastic_slip()
-        return SlipStats(
-            n_points=self.n_points_global,
-            n_contact=c.allreduce(int(res.contact.sum()), op=MPI.SUM),
-            n_slipping=c.allreduce(int(res.slipping.sum()), op=MPI.SUM),
-            contact_area=c.allreduce(float(self._weights[res.contact].sum()), op=MPI.SUM),
-            slipping_area=c.allreduce(float(self._weights[res.slipping].sum()), op=MPI.SUM),
-            max_slip=c.allreduce(float(slip.max(initial=0.0)), op=MPI.MAX),
-            max_plastic_slip=c.allreduce(
-                float(np.linalg.norm(ps, axis=1).max(initial=0.0)), op=MPI.MAX
-            ),
-        )
+        plastic = np.linalg.norm(self.history.trial.plastic_slip, axis=1)
+        maxima = np.array([slip.max(initial=0.0), plastic.max(initial=0.0)])
+        self.comm.Allreduce(MPI.IN_PLACE, maxima, op=MPI.MAX)
+        return InterfaceSummary(
+            n_points=self.n_points_global, n_contact=int(sums[8]), n_slipping=int(sums[9]),
+            contact_force=sums[:3], real_area=float(sums[3]), nominal_area=float(sums[4]),
+            contact_area=float(sums[5]), slipping_area=float(sums[6]),
+            max_slip=float(maxima[0]), max_plastic_slip=float(maxima[1]),
+            dissipation=float(sums[7]))
 
-    def _plastic_slip(self) -> np.ndarray:
-        ps = getattr(self.trial, "plastic_slip", None)
-        if ps is None:
-            return np.zeros((self.n_points, 2))
-        return np.asarray(ps)[:, :2]
+    def slip_stats(self) -> InterfaceSummary:
+        """Same as :meth:`summary` (the name older callers use)."""
+        return self.summary()
 
     def point_coordinates(self) -> np.ndarray:
         """(n_pts, 3) reference coordinates of this rank's interface points [mm]."""
@@ -640,12 +710,110 @@ class ContactInterface:
             area_fraction=np.asarray(res.area_fraction),
             gap=jump[:, 0],
             slip=jump[:, 1:],
-            plastic_slip=self._plastic_slip(),
-            dissipation=self._diss_committed + 0.0,
+            plastic_slip=np.array(self.history.trial.plastic_slip, dtype=float),
+            dissipation=self.history.dissipated.copy(),
             contact=np.asarray(res.contact),
             slipping=np.asarray(res.slipping),
             weight=self._weights,
         )
+
+
+def _check_arguments(V, law, first_tag, second_tag, rigid_plane, quadrature_degree,
+                     grain_direction, match_tolerance) -> tuple[np.ndarray, int]:
+    """Validate ContactInterface's arguments; return the grain direction (3,) and the degree."""
+    missing = [m for m in ("initial_state", "evaluate") if not callable(getattr(law, m, None))]
+    if missing or not isinstance(law, InterfaceLawProtocol):
+        raise TypeError(
+            f"law {type(law).__name__} does not satisfy InterfaceLawProtocol "
+            f"(rough_contact.interface.contract): missing method(s) {', '.join(missing)}")
+    msh = V.mesh
+    if msh.topology.dim != 3 or msh.topology.cell_type not in _CELLS:
+        raise ValueError(
+            "ContactInterface needs a tetrahedral or hexahedral 3D mesh, got "
+            f"{msh.topology.cell_type}"
+        )
+    bs = V.dofmap.index_map_bs
+    element = V.element.basix_element
+    if bs != 3 or element.degree not in (1, 2) or element.family != basix.ElementFamily.P:
+        raise ValueError(
+            f"V must be a vector Lagrange space of degree 1 or 2 with 3 components, got "
+            f"block size {bs}, degree {element.degree}"
+        )
+    if V.element.needs_dof_transformations:
+        raise ValueError("V needs DOF transformations on facets (degree >= 3): not supported")
+    if msh.geometry.cmap.degree not in (1, 2):
+        raise ValueError(f"geometry degree {msh.geometry.cmap.degree} not supported (1 or 2)")
+    if second_tag is not None and second_tag == first_tag:
+        raise ValueError(f"first_tag and second_tag are both {first_tag}")
+    if second_tag is not None and rigid_plane is not None:
+        raise ValueError("give either second_tag or rigid_plane, not both")
+    degree = check_scalar("quadrature_degree", quadrature_degree, lo=0, lo_open=False)
+    if degree != int(degree):
+        raise ValueError(f"quadrature_degree = {quadrature_degree!r} is invalid: it must be an "
+                         "integer >= 0")
+    check_scalar("match_tolerance", match_tolerance, lo=0.0)
+    grain = np.asarray(grain_direction, dtype=float)
+    if grain.shape != (3,) or not np.all(np.isfinite(grain)) or np.linalg.norm(grain) == 0:
+        raise ValueError(f"grain_direction = {grain_direction!r} must be a nonzero 3-vector")
+    return grain, int(degree)
+
+
+_STRICT_RESULT_TYPE = False
+
+
+def _check_result(law, res, n: int) -> None:
+    """The full contract check of a law's result (done on the first evaluation)."""
+    if _STRICT_RESULT_TYPE and not isinstance(res, LawResult):  # TEMP until the contract merge
+        raise LawContractError(
+            f"{type(law).__name__}.evaluate returned {type(res).__name__}; the contract needs "
+            "rough_contact.interface.contract.LawResult")
+    LawResult.check(res, n)
+
+
+def _facet_connectivity(msh) -> int:
+    """Create facet-cell connectivities; return the number of owned facets."""
+    tdim = msh.topology.dim
+    msh.topology.create_connectivity(tdim - 1, tdim)
+    msh.topology.create_connectivity(tdim, tdim - 1)
+    return msh.topology.index_map(tdim - 1).size_local
+
+
+@dataclass(frozen=True)
+class _FacetRule:
+    """Facet quadrature on every local facet of the reference cell.
+
+    Attributes:
+        nq: points per facet.
+        weights: (nq,) reference facet weights.
+        lam: (nq, nv) vertex weights of the points: barycentric (triangle) or bilinear
+            (quadrilateral). A point of the shared surface has the same weights on both sides
+            (up to the vertex permutation), so they carry the partner's reference coordinates.
+        vertices: (n_lf, nv, 3) reference coordinates of each local facet's vertices.
+        points: (n_lf, nq, 3) the points in reference cell coordinates, per local facet.
+        tangents: (n_lf, 3, 2) reference tangents of each local facet.
+        normals: (n_lf, 3) reference outward normals.
+    """
+
+    nq: int
+    weights: np.ndarray
+    lam: np.ndarray
+    vertices: np.ndarray
+    points: np.ndarray
+    tangents: np.ndarray
+    normals: np.ndarray
+
+    @classmethod
+    def create(cls, msh, degree: int) -> _FacetRule:
+        cell = _basix_cell(msh)
+        facet_cell = _CELLS[msh.topology.cell_type][1]
+        ref_facets = np.array(basix.topology(cell)[2])  # (n_lf, nv)
+        xi, w_ref = basix.make_quadrature(facet_cell, degree)
+        lam = _vertex_weights(facet_cell, xi)  # (nq, nv)
+        fv_ref = basix.geometry(cell)[ref_facets]  # (n_lf, nv, 3)
+        X_lf = np.einsum("qi,fid->fqd", lam, fv_ref)  # (n_lf, nq, 3) points per local facet
+        T_lf = np.stack([fv_ref[:, 1] - fv_ref[:, 0], fv_ref[:, 2] - fv_ref[:, 0]], axis=2)
+        N_lf = basix.cell.facet_outward_normals(cell)  # (n_lf, 3)
+        return cls(w_ref.size, w_ref, lam, fv_ref, X_lf, T_lf, N_lf)
 
 
 _CELLS = {
@@ -675,11 +843,11 @@ def _vertex_weights(facet_cell, xi: np.ndarray) -> np.ndarray:
     return np.column_stack([(1 - a) * (1 - b), a * (1 - b), (1 - a) * b, a * b])
 
 
-def _plane(rigid_plane) -> tuple[np.ndarray, np.ndarray]:
-    if hasattr(rigid_plane, "point") and hasattr(rigid_plane, "normal"):
-        point, normal = rigid_plane.point, rigid_plane.normal
-    else:
+def _plane(rigid_plane: RigidPlane) -> tuple[np.ndarray, np.ndarray]:
+    try:
         point, normal = rigid_plane
+    except (TypeError, ValueError):
+        raise ValueError(f"rigid_plane = {rigid_plane!r} must be (point (3,), normal (3,))")
     point = np.asarray(point, dtype=float)
     normal = np.asarray(normal, dtype=float)
     if point.shape != (3,) or normal.shape != (3,) or not np.all(np.isfinite(normal)):

@@ -9,10 +9,10 @@ The discrete problem solved at load factor ``lam`` is
 
 with ``K`` the (linear) bulk stiffness of all bodies, ``f`` the external load vector at
 ``lam = 1`` and ``R_c`` the interface residual of a
-:class:`rough_contact.fem.contact.ContactInterface` (any object with ``assemble_residual(u, b)``
-and ``assemble_jacobian(u, A)``).  The bulk part is linear, so ``K`` is assembled once, into a
-matrix whose sparsity already has room for the interface blocks (DESIGN.md section 4); every
-Jacobian is a copy of ``K`` with the same pattern plus the interface values.
+:class:`rough_contact.fem.contact.ContactInterface`.  The bulk part is linear, so ``K`` is
+assembled once, into a matrix whose sparsity already has room for the interface blocks
+(``docs/design.md``, "Sparsity" and "Bulk matrix reuse"); every Jacobian is a copy of ``K``
+with the same pattern plus the interface values.
 
 Dirichlet conditions are imposed on rows and columns of ``K`` (diagonal 1); their prescribed
 values enter the residual through a lifting vector computed once, and the iterate is kept equal
@@ -32,6 +32,9 @@ from dolfinx.fem import petsc as fem_petsc
 from mpi4py import MPI
 from petsc4py import PETSc
 
+from rough_contact.fem.contact import ContactInterface
+from rough_contact.validation import check_scalar
+
 __all__ = ["Material", "SurfaceLoad", "ContactProblem", "rigid_body_modes"]
 
 
@@ -48,10 +51,8 @@ class Material:
     nu: float
 
     def __post_init__(self):
-        if not (np.isfinite(self.E) and self.E > 0.0):
-            raise ValueError(f"Young's modulus E = {self.E!r} MPa must be finite and > 0")
-        if not (-1.0 < self.nu < 0.5):
-            raise ValueError(f"Poisson's ratio nu = {self.nu!r} must lie in (-1, 0.5)")
+        check_scalar("Young's modulus E", self.E, lo=0.0, unit="MPa")
+        check_scalar("Poisson's ratio nu", self.nu, lo=-1.0, hi=0.5)
 
     @property
     def lame(self) -> tuple[float, float]:
@@ -84,13 +85,17 @@ class SurfaceLoad:
                 f"SurfaceLoad(tag={self.tag}): give exactly one of force= or traction= "
                 f"(got force={self.force!r}, traction={self.traction!r})"
             )
+        name, unit = ("force", "N") if self.force is not None else ("traction", "MPa")
         vec = self.force if self.force is not None else self.traction
-        arr = np.asarray(vec, dtype=float)
-        if arr.shape != (3,) or not np.all(np.isfinite(arr)):
-            raise ValueError(f"SurfaceLoad(tag={self.tag}) vector {vec!r} must be 3 finite numbers")
+        if np.shape(vec) != (3,):
+            raise ValueError(f"SurfaceLoad(tag={self.tag}).{name} = {vec!r} is invalid: it must "
+                             f"be 3 numbers, got shape {np.shape(vec)}")
+        for i, value in enumerate(vec):
+            check_scalar(f"SurfaceLoad(tag={self.tag}).{name}[{i}]", value, unit=unit)
 
 
-def rigid_body_modes(V: fem.FunctionSpace, cell_groups: Sequence[np.ndarray] = ()) -> PETSc.NullSpace:
+def rigid_body_modes(V: fem.FunctionSpace,
+                     cell_groups: Sequence[np.ndarray] = ()) -> PETSc.NullSpace:
     """Near-nullspace of 3D elasticity for algebraic multigrid (GAMG).
 
     Args:
@@ -141,17 +146,20 @@ class ContactProblem:
         loads: surface loads scaled by the load factor.
         cell_tags: cell MeshTags (needed for per-body materials and per-body rigid modes).
         facet_tags: facet MeshTags (needed for surface loads and seating stiffness).
-        interface: the contact interface (``assemble_residual``, ``assemble_jacobian``,
-            optionally ``create_matrix``); ``None`` gives a pure bulk problem.
+        interface: the contact interface; ``None`` gives a pure bulk problem.
         seating_tag: facet tag of a contact surface on which a small spring to ground of
             stiffness ``seating_stiffness`` [MPa/mm] is added to the JACOBIAN ONLY while no
             interface point is in contact (a body held only by contact has a singular first
             Jacobian at zero pressure; the residual is untouched so converged answers are not
             changed).
-        seating_stiffness: see ``seating_tag`` [MPa/mm].
+        seating_stiffness: see ``seating_tag`` [MPa/mm], >= 0.
         quadrature_degree: optional quadrature degree for the bulk forms.
         body_cells: local cell indices of each disconnected body (one array per body), for a
             near-nullspace built per body; empty = the six global rigid-body modes.
+
+    Raises:
+        TypeError: ``interface`` is neither a ContactInterface nor None.
+        ValueError: bad materials, loads or seating stiffness (naming the quantity).
     """
 
     def __init__(
@@ -162,12 +170,15 @@ class ContactProblem:
         loads: Sequence[SurfaceLoad] = (),
         cell_tags=None,
         facet_tags=None,
-        interface=None,
+        interface: Optional[ContactInterface] = None,
         seating_tag: Optional[int] = None,
         seating_stiffness: float = 0.0,
         quadrature_degree: Optional[int] = None,
         body_cells: Sequence[np.ndarray] = (),
     ):
+        if interface is not None and not isinstance(interface, ContactInterface):
+            raise TypeError(f"interface must be a ContactInterface or None, got "
+                            f"{type(interface).__name__}")
         msh = V.mesh
         self.V, self.mesh, self.comm = V, msh, msh.comm
         self.bcs = list(bcs)
@@ -211,7 +222,8 @@ class ContactProblem:
                 fem.assemble_scalar(fem.form(fem.Constant(msh, 1.0) * ds(load.tag))), op=MPI.SUM
             )
             if area <= 0.0:
-                raise ValueError(f"surface load tag {load.tag}: tagged area is {area} mm^2, must be > 0")
+                raise ValueError(f"surface load tag {load.tag}: tagged area = {area} mm^2 is "
+                                 "invalid: it must be > 0")
             if load.force is not None:
                 t = np.asarray(load.force, dtype=float) / area
             else:
@@ -224,7 +236,7 @@ class ContactProblem:
 
         # Bulk stiffness, once, into a matrix with room for the interface blocks.
         t0 = MPI.Wtime()
-        if interface is not None and hasattr(interface, "create_matrix"):
+        if interface is not None:
             self.K = interface.create_matrix(self.a)
         else:
             self.K = fem_petsc.create_matrix(self.a)
@@ -245,12 +257,12 @@ class ContactProblem:
         fem_petsc.set_bc(self.lift, self.bcs, scale=0.0)
         self.f_norm = self.f.norm()
 
-        self.seating_stiffness = float(seating_stiffness)
-        if self.seating_stiffness < 0.0 or not np.isfinite(self.seating_stiffness):
-            raise ValueError(f"seating_stiffness = {seating_stiffness} MPa/mm must be finite and >= 0")
+        self.seating_stiffness = check_scalar("seating_stiffness", seating_stiffness, lo=0.0,
+                                              lo_open=False, unit="MPa/mm")
         self.M_seat = None
         if seating_tag is not None and self.seating_stiffness > 0.0:
-            m = fem.form(fem.Constant(msh, self.seating_stiffness) * ufl.inner(u, v) * ds(seating_tag))
+            k_seat = fem.Constant(msh, self.seating_stiffness)
+            m = fem.form(k_seat * ufl.inner(u, v) * ds(seating_tag))
             # On the pattern of K (a superset), so it can be added with SAME_NONZERO_PATTERN.
             self.M_seat = self.K.duplicate(copy=False)
             self.M_seat.zeroEntries()
@@ -310,19 +322,12 @@ class ContactProblem:
 
     # ------------------------------------------------------------------ helpers
     def n_in_contact(self) -> int:
-        """Global number of interface points in contact at the last evaluation."""
-        ci = self.interface
-        if ci is None:
-            return 0
-        if hasattr(ci, "slip_stats"):
-            return int(ci.slip_stats().n_contact)
-        return 1  # unknown: assume contact, never add the seating spring
+        """Global number of interface points in contact at the last evaluation (collective)."""
+        return 0 if self.interface is None else self.interface.n_contact()
 
     def set_load_factor(self, lam: float) -> None:
         """Set the load factor ``lam`` (external loads are ``lam`` times their nominal value)."""
-        if not np.isfinite(lam):
-            raise ValueError(f"load factor = {lam!r} must be finite")
-        self.load_factor = float(lam)
+        self.load_factor = check_scalar("load factor", lam)
 
     def reset_timings(self) -> None:
         for k in self.timings:

@@ -10,10 +10,15 @@ so a caller can write output and stop at any time with every converged increment
     for inc in load_path(problem, solver, load_unload_factors(16)):
         writer.write(inc)
 
-A step that fails (SNES diverged, a non-finite residual, or a law raising ``ValueError``,
-``ArithmeticError`` or ``RuntimeError`` such as a local return-map failure) is reverted
-(displacement and interface history back to the last committed state) and retried with half the increment, down to ``min_increment``; then a
-:class:`LoadStepError` names the load factor that could not be reached.
+A step that fails to CONVERGE is reverted (displacement and interface history back to the
+last committed state) and retried with half the increment, down to ``min_increment``; then a
+:class:`LoadStepError` names the load factor that could not be reached. Convergence failures
+are exactly: SNES diverged (negative converged reason, e.g. DIVERGED_LINEAR_SOLVE when the
+factorisation fails, DIVERGED_MAX_IT, a line-search failure), a non-finite residual norm, and a
+:class:`~rough_contact.interface.contract.ConvergenceError` (a law's local Newton such as the
+friction return map, a non-finite jump, traction or tangent), which the interface raises on
+every rank together. Any other exception (bad input, a programming error, a ``PETSc.Error``)
+propagates at once with its type and traceback: no cutback, no LoadStepError.
 """
 
 from __future__ import annotations
@@ -26,11 +31,17 @@ import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
 
-__all__ = ["Increment", "LoadStepError", "load_path", "load_unload_factors", "interface_summary"]
+from rough_contact.fem.problem import ContactProblem
+from rough_contact.interface.contract import ConvergenceError
+from rough_contact.solver.snes import SNESSolver, SolveResult
+from rough_contact.validation import check_scalar
+
+__all__ = ["Increment", "LoadStepError", "load_path", "load_unload_factors"]
 
 
 class LoadStepError(RuntimeError):
-    """Raised when a load step cannot converge even with the minimum increment.
+    """Raised when a load step cannot converge even with the minimum increment (chained from
+    the last ConvergenceError, if that was the cause).
 
     Attributes:
         load_factor: the load factor that could not be reached.
@@ -97,46 +108,17 @@ def load_unload_factors(n_load: int, n_unload: Optional[int] = None,
     Returns:
         List of load factors.
     """
-    if int(n_load) != n_load or n_load < 1:
-        raise ValueError(f"n_load = {n_load!r} must be an integer >= 1")
+    if check_scalar("n_load", n_load, lo=1, lo_open=False) != int(n_load):
+        raise ValueError(f"n_load = {n_load!r} is invalid: it must be an integer >= 1")
     up = [(i + 1) / n_load for i in range(n_load)]
     if n_unload is None:
         n_unload = n_load - 1
-    if int(n_unload) != n_unload or n_unload < 0:
-        raise ValueError(f"n_unload = {n_unload!r} must be an integer >= 0")
-    final = 1.0 / n_load if final_factor is None else float(final_factor)
-    if not (0.0 <= final < 1.0):
-        raise ValueError(f"final_factor = {final_factor!r} must lie in [0, 1)")
+    if check_scalar("n_unload", n_unload, lo=0, lo_open=False) != int(n_unload):
+        raise ValueError(f"n_unload = {n_unload!r} is invalid: it must be an integer >= 0")
+    final = 1.0 / n_load if final_factor is None else check_scalar(
+        "final_factor", final_factor, lo=0.0, lo_open=False, hi=1.0)
     down = [1.0 - (1.0 - final) * (i + 1) / n_unload for i in range(n_unload)]
     return up + down
-
-
-def interface_summary(interface, comm: MPI.Comm) -> dict:
-    """Global interface figures after the last evaluation (robust to missing methods)."""
-    out = {"n_points": 0, "n_active": 0, "n_slipping": 0, "contact_force": np.zeros(3),
-           "real_area": float("nan"), "dissipation": float("nan")}
-    if interface is None:
-        return out
-
-    def get(name):
-        val = getattr(interface, name, None)
-        return val() if callable(val) else val
-
-    if hasattr(interface, "slip_stats"):
-        stats = interface.slip_stats()
-        out["n_points"] = int(stats.n_points)
-        out["n_active"] = int(stats.n_contact)
-        out["n_slipping"] = int(stats.n_slipping)
-    val = get("contact_force")
-    if val is not None:
-        out["contact_force"] = np.asarray(val, dtype=float).reshape(-1)
-    val = get("real_contact_area")
-    if val is not None:
-        out["real_area"] = float(val)
-    val = get("dissipation")
-    if val is not None:
-        out["dissipation"] = float(val)
-    return out
 
 
 def _print_increment(inc: Increment) -> None:
@@ -150,15 +132,16 @@ def _print_increment(inc: Increment) -> None:
     )
 
 
-def load_path(problem, solver, factors: Iterable[float], *, min_increment: float = 1e-4,
-              max_growth: float = 2.0, verbose: bool = True) -> Iterator[Increment]:
+def load_path(problem: ContactProblem, solver: SNESSolver, factors: Iterable[float], *,
+              min_increment: float = 1e-4, max_growth: float = 2.0,
+              verbose: bool = True) -> Iterator[Increment]:
     """Follow ``factors`` with Newton solves; yield after each converged, committed step.
 
     Args:
         problem: :class:`~rough_contact.fem.problem.ContactProblem` (its ``u`` and interface
             carry the state; they start from the currently committed state).
         solver: :class:`~rough_contact.solver.snes.SNESSolver` of ``problem``.
-        factors: load factors to reach in order (loading and unloading alike).
+        factors: load factors to reach in order (loading and unloading alike), finite.
         min_increment: smallest load-factor increment tried in a cutback (> 0).
         max_growth: after a cutback, a converged sub-step lets the next one grow by this
             factor (>= 1) until the target is reached.
@@ -168,21 +151,18 @@ def load_path(problem, solver, factors: Iterable[float], *, min_increment: float
         :class:`Increment` per converged step.
 
     Raises:
-        LoadStepError: a step failed with an increment below ``min_increment``.
+        LoadStepError: a step failed to converge with an increment below ``min_increment``.
+        Exception: anything that is not a convergence failure, unchanged (see the module).
     """
-    if not (min_increment > 0.0 and np.isfinite(min_increment)):
-        raise ValueError(f"min_increment = {min_increment!r} must be finite and > 0")
-    if not (max_growth >= 1.0):
-        raise ValueError(f"max_growth = {max_growth!r} must be >= 1")
+    check_scalar("min_increment", min_increment, lo=0.0)
+    check_scalar("max_growth", max_growth, lo=1.0, lo_open=False)
     comm = problem.comm
     interface = problem.interface
     u_committed = problem.u.vector.copy()
     lam_committed = problem.load_factor
     step = 0
-    for target in factors:
-        target = float(target)
-        if not np.isfinite(target):
-            raise ValueError(f"load factor {target!r} in the load path must be finite")
+    for i, target in enumerate(factors):
+        target = check_scalar(f"load factor {i} of the load path", target)
         delta = target - lam_committed
         cutbacks = 0
         t_start = time.perf_counter()
@@ -193,7 +173,7 @@ def load_path(problem, solver, factors: Iterable[float], *, min_increment: float
                 delta = target - lam_committed
             lam = lam_committed + delta
             problem.set_load_factor(lam)
-            ok, result, err = _attempt(solver, comm)
+            ok, result, failure = _attempt(solver, comm)
             if ok:
                 # Re-evaluate at the converged iterate so the trial history matches it.
                 problem.F(None, solver.x, problem.b)
@@ -202,13 +182,18 @@ def load_path(problem, solver, factors: Iterable[float], *, min_increment: float
                 problem.u.vector.copy(u_committed)
                 lam_committed = lam
                 step += 1
-                summary = interface_summary(interface, comm)
                 inc = Increment(
                     step=step, load_factor=lam, target=target, iterations=result.iterations,
                     residual=result.residuals[-1] if result.residuals else float("nan"),
                     residuals=list(result.residuals), applied_force=lam * problem.applied_force,
                     cutbacks=cutbacks, wall_time=time.perf_counter() - t_start,
-                    linear_solver=solver.linear_solver, **summary)
+                    linear_solver=solver.linear_solver)
+                if interface is not None:
+                    s = interface.summary()
+                    inc.n_points, inc.n_active, inc.n_slipping = (s.n_points, s.n_contact,
+                                                                  s.n_slipping)
+                    inc.contact_force, inc.real_area = s.contact_force, s.real_area
+                    inc.dissipation = s.dissipation
                 if verbose:
                     _print_increment(inc)
                 yield inc
@@ -216,40 +201,39 @@ def load_path(problem, solver, factors: Iterable[float], *, min_increment: float
                 if cutbacks:
                     delta *= max_growth
                 continue
-            # Failure: revert to the committed state and halve the increment.
+            # Failure to converge: revert to the committed state and halve the increment.
             u_committed.copy(problem.u.vector)
             problem.u.x.scatter_forward()
             problem.set_load_factor(lam_committed)
             if interface is not None:
                 interface.revert()
-            why = err if err else f"{result.reason_name} after {result.iterations} its"
+            if failure is not None:
+                why = f"{type(failure).__name__}: {failure}"
+            else:
+                why = f"{result.reason_name} after {result.iterations} its"
             delta *= 0.5
             cutbacks += 1
             if abs(delta) < min_increment:
                 raise LoadStepError(
                     f"load step to load factor {lam:.6g} (target {target:.6g}) failed ({why}); "
                     f"cutback below the minimum increment {min_increment:g}; last converged load "
-                    f"factor {lam_committed:.6g} is committed", lam, lam_committed)
+                    f"factor {lam_committed:.6g} is committed", lam, lam_committed) from failure
             if verbose:
                 PETSc.Sys.Print(f"  load {lam:.6g} failed ({why}): cutback to increment "
                                 f"{delta:.4g}")
 
 
-def _attempt(solver, comm):
-    """One SNES solve; a law/geometry error on any rank is turned into a global failure."""
-    err = ""
+def _attempt(solver: SNESSolver, comm: MPI.Comm):
+    """One Newton solve. Returns ``(converged on every rank, SolveResult or None, the
+    ConvergenceError or None)``; every other exception propagates."""
+    failure = None
     try:
         result = solver.solve()
         ok = result.converged
-    except (ValueError, ArithmeticError, RuntimeError) as exc:
-        # a law error (bad input, local return-map failure) raised inside a SNES callback
-        # reaches us unchanged; a smaller increment is the remedy. The interface raises such
-        # errors on every rank together (it gathers them before any later collective).
-        result, ok, err = None, False, f"{type(exc).__name__}: {exc}"
-    # Every rank must agree (an exception on one rank only would otherwise hang the others).
+    except ConvergenceError as exc:
+        # raised on every rank together by the interface (rough_contact.fem.collective)
+        result, ok, failure = None, False, exc
     ok_all = comm.allreduce(bool(ok), op=MPI.LAND)
     if result is None:
-        from rough_contact.solver.snes import SolveResult
-
-        result = SolveResult(False, -1, "EXCEPTION", 0, [])
-    return ok_all, result, err
+        result = SolveResult(False, 0, "CONVERGENCE_ERROR", 0, [])
+    return ok_all, result, failure

@@ -19,33 +19,45 @@ Point fields come gathered to rank 0 in global point order (rank by rank).
 from __future__ import annotations
 
 import csv
+import io
 import os
-from typing import Optional
+from typing import Iterable, Optional, Union
 
 import numpy as np
 from mpi4py import MPI
 
-__all__ = ["ResultWriter", "gather_points", "atomic_write_text"]
+__all__ = ["ResultWriter", "gather_points", "atomic_write", "atomic_write_text"]
+
+
+def atomic_write(path: str, content: Union[str, bytes, Iterable[bytes]]) -> None:
+    """Write ``content`` to ``path`` atomically: a temporary file, fsync, ``os.replace``.
+
+    A crash leaves either the old file or the new one, never a truncated one. Every file this
+    module writes goes through here.
+
+    Args:
+        path: destination.
+        content: text (written as UTF-8, newlines unchanged), bytes, or an iterable of bytes
+            chunks (written one after the other).
+    """
+    if isinstance(content, str):
+        chunks: Iterable[bytes] = [content.encode("utf-8")]
+    elif isinstance(content, (bytes, bytearray)):
+        chunks = [bytes(content)]
+    else:
+        chunks = content
+    tmp = f"{path}.tmp{os.getpid()}"
+    with open(tmp, "wb") as fh:
+        for chunk in chunks:
+            fh.write(chunk)
+        fh.flush()
+        os.fsync(fh.fileno())
+    os.replace(tmp, path)
 
 
 def atomic_write_text(path: str, text: str) -> None:
-    """Write ``text`` to ``path`` through a temporary file and ``os.replace`` (atomic)."""
-    tmp = f"{path}.tmp{os.getpid()}"
-    with open(tmp, "w") as fh:
-        fh.write(text)
-        fh.flush()
-        os.fsync(fh.fileno())
-    os.replace(tmp, path)
-
-
-def _atomic_write_bytes(path: str, chunks) -> None:
-    tmp = f"{path}.tmp{os.getpid()}"
-    with open(tmp, "wb") as fh:
-        for c in chunks:
-            fh.write(c)
-        fh.flush()
-        os.fsync(fh.fileno())
-    os.replace(tmp, path)
+    """Write ``text`` to ``path`` atomically (:func:`atomic_write`)."""
+    atomic_write(path, text)
 
 
 def gather_points(comm: MPI.Comm, points: np.ndarray, fields: dict, root: int = 0):
@@ -145,9 +157,9 @@ class ResultWriter:
             chunks.append(arr.tobytes())
             items.append((key, arr.shape, offset))
             offset += arr.nbytes
-        _atomic_write_bytes(os.path.join(self.outdir, name), chunks)
+        atomic_write(os.path.join(self.outdir, name), chunks)
         self.grids.append((step, t, n, name, items))
-        atomic_write_text(self.pc_path, self._point_cloud_xml())
+        atomic_write(self.pc_path, self._point_cloud_xml())
 
     def _point_cloud_xml(self) -> str:
         lines = ['<?xml version="1.0" ?>', '<Xdmf Version="3.0">', "  <Domain>",
@@ -164,9 +176,9 @@ class ResultWriter:
                 if key == "__geometry__":
                     lines.append(f'        <Geometry GeometryType="XYZ">{item}</Geometry>')
                 else:
-                    kind = "Scalar" if len(shape) == 1 else ("Vector" if shape[1] == 3 else "Matrix")
-                    if len(shape) == 2 and shape[1] == 2:
-                        kind = "Matrix"
+                    # (n,) scalar, (n, 3) vector, anything else (e.g. (n, 2)) a matrix
+                    kind = "Scalar" if len(shape) == 1 else (
+                        "Vector" if shape[1] == 3 else "Matrix")
                     lines.append(f'        <Attribute Name="{key}" AttributeType="{kind}" '
                                  f'Center="Node">{item}</Attribute>')
             lines.append("      </Grid>")
@@ -185,18 +197,18 @@ class ResultWriter:
         header = [c for c, _ in _CSV_COLUMNS] + ["applied_fx_N", "applied_fy_N", "applied_fz_N",
                                                  "contact_fx_N", "contact_fy_N", "contact_fz_N"]
         header += list(self.extra_columns)
-        tmp = f"{self.csv_path}.tmp{os.getpid()}"
-        with open(tmp, "w", newline="") as fh:
-            w = csv.writer(fh)
-            w.writerow(header)
-            for r in self.rows:
-                w.writerow([f"{v:.10g}" if isinstance(v, float) else v for v in r])
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, self.csv_path)
+        text = io.StringIO(newline="")
+        w = csv.writer(text)
+        w.writerow(header)
+        for r in self.rows:
+            w.writerow([f"{v:.10g}" if isinstance(v, float) else v for v in r])
+        atomic_write(self.csv_path, text.getvalue())
 
     def write(self, inc, extra: Optional[dict] = None) -> None:
-        """Write increment ``inc`` (an :class:`~rough_contact.solver.loading.Increment`). Collective."""
+        """Write increment ``inc`` (a :class:`~rough_contact.solver.loading.Increment`).
+
+        Collective.
+        """
         t = float(inc.step)
         if self.u is not None:
             self._write_displacement(t)

@@ -18,6 +18,7 @@ import dolfinx.fem.petsc
 from dolfinx import fem
 from dolfinx import mesh as dmesh
 from rough_contact.fem.contact import ContactInterface
+from rough_contact.interface.contract import ConvergenceError
 from rough_contact.interface.penalty import LinearPenalty, SoftplusPenalty
 
 LOWER_TOP, UPPER_BOTTOM, LOWER_BOTTOM, UPPER_TOP = 1, 2, 3, 4
@@ -269,9 +270,14 @@ def test_uniform_jump_patch():
     on_lower = comm.allreduce(np.bincount(comp[~upper], arr[~upper], minlength=3))
     np.testing.assert_allclose(on_upper, t * area, rtol=1e-12)
     np.testing.assert_allclose(on_lower, -t * area, rtol=1e-12)
-    st = ci.slip_stats()
+    st = ci.summary()
     assert st.n_points == ci.n_points_global and st.n_contact == st.n_points  # d_z < 0: closed
+    assert ci.n_contact() == st.n_points
     np.testing.assert_allclose(st.max_slip, np.hypot(d[0], d[1]), rtol=1e-12)
+    np.testing.assert_allclose(st.contact_force, t * area, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose([st.nominal_area, st.real_area, st.contact_area],
+                               [area, area, area], rtol=1e-13)
+    assert st.n_slipping == 0 and st.slipping_area == 0.0 and st.dissipation == 0.0
 
 
 def _global_figures(comm, degree, patch):
@@ -293,7 +299,7 @@ def _global_figures(comm, degree, patch):
     ci.assemble_jacobian(u, A)
     A.assemble()
     ci.commit()
-    st = ci.slip_stats()
+    st = ci.summary()
     return (
         ci.n_points, np.concatenate([
             ci.contact_force(), [ci.real_contact_area(), ci.nominal_area(), ci.dissipation(),
@@ -325,6 +331,14 @@ def test_errors():
         ContactInterface(V, tags, LOWER_TOP, UPPER_TOP, law=law)
     with pytest.raises(ValueError, match="grain_direction"):
         ContactInterface(V, tags, LOWER_TOP, UPPER_BOTTOM, law=law, grain_direction=(0, 0, 1))
+    with pytest.raises(ValueError, match="quadrature_degree = 1.5 is invalid"):
+        ContactInterface(V, tags, LOWER_TOP, UPPER_BOTTOM, law=law, quadrature_degree=1.5)
+    with pytest.raises(ValueError, match="quadrature_degree = -1 is invalid"):
+        ContactInterface(V, tags, LOWER_TOP, UPPER_BOTTOM, law=law, quadrature_degree=-1)
+    with pytest.raises(ValueError, match="match_tolerance = 0.0 is invalid"):
+        ContactInterface(V, tags, LOWER_TOP, UPPER_BOTTOM, law=law, match_tolerance=0.0)
+    with pytest.raises(ValueError, match="rigid_plane"):
+        ContactInterface(V, tags, LOWER_TOP, law=law, rigid_plane=(0.0, 0.0, 1.0))
 
     class NaNLaw:
         def initial_state(self, n):
@@ -336,7 +350,8 @@ def test_errors():
             return r
 
     ci = ContactInterface(V, tags, LOWER_TOP, UPPER_BOTTOM, law=NaNLaw())
-    with pytest.raises(ValueError, match="non-finite"):
+    # a convergence failure on every rank (also on a rank whose own points are all finite)
+    with pytest.raises(ConvergenceError, match="non-finite traction"):
         ci.evaluate(fem.Function(V))
 
 
@@ -487,6 +502,9 @@ def test_history_commit_revert_and_dissipation():
     area = 1.0
     np.testing.assert_allclose(ci.dissipation(), mu * p * sp * area, rtol=1e-12)
     np.testing.assert_allclose(ci.point_fields().plastic_slip[:, 0], sp, rtol=1e-12)
+    st = ci.summary()
+    np.testing.assert_allclose([st.dissipation, st.max_plastic_slip], [mu * p * sp * area, sp],
+                               rtol=1e-12)
     # same displacement again, from the new committed state: elastic, no new dissipation
     res = ci.evaluate(u)
     assert comm.allreduce(int(res.slipping.sum())) == 0
@@ -495,8 +513,8 @@ def test_history_commit_revert_and_dissipation():
     ci.evaluate(u)
     ci.revert()
     np.testing.assert_allclose(ci.dissipation(), mu * p * sp * area, rtol=1e-12)
-    np.testing.assert_allclose(ci.committed.plastic_slip[:, 0], sp, rtol=1e-12)
-    np.testing.assert_allclose(ci.trial.plastic_slip[:, 0], sp, rtol=1e-12)
+    np.testing.assert_allclose(ci.history.committed.plastic_slip[:, 0], sp, rtol=1e-12)
+    np.testing.assert_allclose(ci.history.trial.plastic_slip[:, 0], sp, rtol=1e-12)
 
 
 @pytest.mark.parametrize("degree", [1, 2])

@@ -68,6 +68,32 @@ def test_bad_input_raises():
         Material(-1.0, 0.3)
     with pytest.raises(ValueError, match="exactly one"):
         SurfaceLoad(1)
+    with pytest.raises(ValueError, match=r"SurfaceLoad\(tag=2\)\.force\[1\] = nan N is invalid"):
+        SurfaceLoad(2, force=[0.0, np.nan, 1.0])
+    with pytest.raises(ValueError, match=r"SurfaceLoad\(tag=2\)\.traction = \[1, 2\] is invalid"):
+        SurfaceLoad(2, traction=[1, 2])
+    scene = block_on_plane(lx=1.0, ly=1.0, h=1.0, mesh_size=0.6, order=1)
+    V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", 1))
+    with pytest.raises(ValueError, match=r"seating_stiffness = -1.0 MPa/mm is invalid: it must "
+                                         r"be finite and >= 0"):
+        ContactProblem(V, Material(E, NU), seating_stiffness=-1.0)
+    with pytest.raises(TypeError, match="interface must be a ContactInterface or None, got dict"):
+        ContactProblem(V, Material(E, NU), interface={})
+    problem = ContactProblem(V, Material(E, NU))
+    solver = SNESSolver(problem, prefix="test_bad_")
+    from rough_contact.solver.loading import load_path, load_unload_factors
+
+    for kwargs, message in (({"min_increment": 0.0}, "min_increment = 0.0 is invalid"),
+                            ({"max_growth": 0.5}, "max_growth = 0.5 is invalid"),
+                            ({"factors": [0.5, np.inf]}, "load factor 1 of the load path")):
+        args = dict(factors=[0.5], verbose=False) | kwargs
+        with pytest.raises(ValueError, match=message):
+            list(load_path(problem, solver, **args))
+    with pytest.raises(ValueError, match="n_load = 2.5 is invalid"):
+        load_unload_factors(2.5)
+    with pytest.raises(ValueError, match="final_factor = 1.0 is invalid"):
+        load_unload_factors(4, final_factor=1.0)
+    solver.destroy()
 
 
 # ----------------------------------------------------------------------------------------------
@@ -75,6 +101,7 @@ def test_bad_input_raises():
 # ----------------------------------------------------------------------------------------------
 from meshes.blocks import two_blocks  # noqa: E402
 from rough_contact.fem.contact import ContactInterface  # noqa: E402
+from rough_contact.interface.contract import ConvergenceError  # noqa: E402
 from rough_contact.interface.penalty import LinearPenalty  # noqa: E402
 from rough_contact.solver.loading import LoadStepError, load_path  # noqa: E402
 
@@ -223,11 +250,17 @@ def test_seating_spring_for_body_held_only_by_contact():
 # cutback
 # ----------------------------------------------------------------------------------------------
 class _GapState:
+    """History of StepLimitedPenalty: the committed normal jump (a LawState: no plastic slip)."""
+
     def __init__(self, g):
         self.g = g
+        self.plastic_slip = np.zeros((g.size, 2))
 
     def copy(self):
         return _GapState(self.g.copy())
+
+    def __len__(self):
+        return self.g.size
 
 
 class StepLimitedPenalty:
@@ -279,4 +312,109 @@ def test_cutback_exhausted_names_load_factor():
     assert [i.load_factor for i in done] == [0.5e-4]  # the converged increment was kept
     assert info.value.last_converged == 0.5e-4
     assert 0.5e-4 < info.value.load_factor < 1.0
+    solver.destroy()
+
+
+# ----------------------------------------------------------------------------------------------
+# errors keep their type: only convergence failures cut back, on every rank together
+# ----------------------------------------------------------------------------------------------
+class RaisingPenalty:
+    """Bilateral linear penalty that raises ``make_error()`` on ``rank`` (None = every rank):
+    always once ``armed``, or (``limit`` given) when the normal jump moves by more than ``limit``
+    [mm] from the committed state in one increment."""
+
+    def __init__(self, k_normal, make_error, rank=None, limit=None):
+        self.inner, self.make_error, self.rank, self.limit = LinearPenalty(k_normal), \
+            make_error, rank, limit
+        self.armed, self.raised, self.calls = False, [], 0
+
+    def initial_state(self, n):
+        return _GapState(np.zeros(n))
+
+    def evaluate(self, jump, committed):
+        self.calls += 1
+        here = self.rank is None or MPI.COMM_WORLD.rank == self.rank
+        too_far = self.limit is not None and np.any(np.abs(jump[:, 0] - committed.g) > self.limit)
+        if here and (self.armed or too_far):
+            self.raised.append(self.make_error())
+            raise self.raised[-1]
+        from dataclasses import replace
+
+        res = self.inner.evaluate(jump, self.inner.initial_state(len(jump)))
+        return replace(res, state=_GapState(jump[:, 0].copy()))
+
+
+class LocalNewtonError(ConvergenceError):
+    """Stands for a law's local Newton failure (module level: importable on every rank)."""
+
+
+def _count_solves(solver):
+    calls = []
+    solve = solver.solve
+
+    def counting():
+        calls.append(1)
+        return solve()
+
+    solver.solve = counting
+    return calls
+
+
+def _prefixed_options(prefix):
+    return sorted(k for k in PETSc.Options().getAll() if k.startswith(prefix))
+
+
+@pytest.mark.parametrize("where", ["every_rank", "rank_0"])
+def test_programming_error_in_law_propagates_at_once(where):
+    """A TypeError inside the law leaves load_path at once, with its type (no cutback, no
+    LoadStepError); on 2 ranks with the failure on rank 0 only, the other rank raises a
+    RuntimeError naming it instead of hanging."""
+    comm = MPI.COMM_WORLD
+    law = RaisingPenalty(1e5, lambda: TypeError("unsupported operand type(s)"),
+                         rank=None if where == "every_rank" else 0)
+    scene, problem, solver, ci = blocks_problem(law, 40.0, prefix="test_prop_")
+    solves = _count_solves(solver)
+    path = load_path(problem, solver, [0.5, 1.0], verbose=False)
+    first = next(path)
+    assert first.load_factor == 0.5 and len(solves) == 1
+    law.armed = True
+    with pytest.raises(Exception) as info:
+        next(path)
+    assert not isinstance(info.value, (LoadStepError, ConvergenceError))
+    assert len(solves) == 2  # the failing solve only: no retry with a smaller increment
+    if law.raised:  # this rank's law raised: the very object, traceback down to the law
+        assert info.value is law.raised[0] and len(law.raised) == 1
+        assert any(tb.name == "evaluate" for tb in info.traceback)
+    else:
+        assert type(info.value) is RuntimeError
+        assert str(info.value) == "rank 0 raised TypeError: unsupported operand type(s)"
+    # the solver's defaults left the options database although the solve raised
+    assert _prefixed_options("test_prop_") == []
+    assert ci.dissipation() == 0.0 and comm.allreduce(len(law.raised)) >= 1
+    solver.destroy()
+
+
+@pytest.mark.parametrize("error", [LocalNewtonError])
+def test_convergence_error_on_one_rank_cuts_back_on_every_rank(error):
+    """A ConvergenceError raised on ONE rank (the first that owns interface points) makes every
+    rank cut back together; the load path still reaches the exact answer."""
+    p, kn = 40.0, 1.0e5
+    g_final = -p / kn
+    law = RaisingPenalty(kn, lambda: error("local Newton did not converge at 1 point"),
+                         rank=-1, limit=0.3 * abs(g_final))
+    scene, problem, solver, ci = blocks_problem(law, p, prefix="test_cut1_")
+    comm = scene.mesh.comm
+    law.rank = next(r for r, n in enumerate(comm.allgather(ci.n_points)) if n > 0)
+    solves = _count_solves(solver)
+    incs = list(load_path(problem, solver, [1.0], verbose=False))
+    assert incs[-1].load_factor == 1.0
+    assert sum(i.cutbacks for i in incs) >= 2
+    # every failed solve is one raise on the failing rank, and a cutback on every rank
+    assert comm.allreduce(len(law.raised), op=MPI.SUM) == len(solves) - len(incs) >= 2
+    lams = [0.0] + [i.load_factor for i in incs]
+    assert max(np.diff(lams)) <= 0.3 + 1e-12
+    assert comm.allgather(lams) == [lams] * comm.size  # every rank took the same steps
+    pf = ci.point_fields()
+    err = comm.allreduce(float(np.max(np.abs(pf.pressure - p), initial=0.0)), op=MPI.MAX)
+    assert err <= 1e-8 * p
     solver.destroy()
