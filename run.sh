@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Single entry point: set-up on a fresh Debian 12 machine (as root) + the two jobs.
 #   bash run.sh demo [args...]   the main job (flat-punch demo once it exists)
-#   bash run.sh test             the test suite: unit tests, FE tests serial and on 2 ranks
+#   bash run.sh test             the test suite: unit tests, FE tests serial and on 2 ranks, demos
 #   bash run.sh setup            only the set-up (idempotent, fast when done)
 #   bash run.sh python ...       run a command with the project's interpreter and environment
 # Optional extras (pyproject [project.optional-dependencies]) are installed when asked:
@@ -90,7 +90,9 @@ case "$cmd" in
             run_pytest "$PY" -m pytest -q --color=no tests/fem
             echo "== FE tests, mpirun -n 2 =="
             run_pytest mpirun -n 2 "$PY" -m mpi4py -m pytest -q --color=no -p no:cacheprovider tests/fem
-        fi ;;
+        fi
+        echo "== demos, run as scripts at a small size =="
+        run_pytest "$PY" -m pytest -q --color=no tests/demos ;;
     python)
         setup
         exec "$PY" "$@" ;;

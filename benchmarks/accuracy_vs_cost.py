@@ -77,16 +77,11 @@ from petsc4py import PETSc  # noqa: E402
 
 from dolfinx import fem  # noqa: E402
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "demos"))
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 
-import demo_beam_rigid_base as beam_demo  # noqa: E402
-import demo_flat_punch as punch_demo  # noqa: E402
-from rough_contact.fem.contact import ContactInterface  # noqa: E402
-from rough_contact.fem.problem import ContactProblem, Material, SurfaceLoad  # noqa: E402
+from rough_contact.scenes import beam as beam_demo  # noqa: E402
+from rough_contact.scenes import flat_punch as punch_demo  # noqa: E402
 from rough_contact.solver.loading import load_path, load_unload_factors  # noqa: E402
 from rough_contact.solver.output import gather_points  # noqa: E402
-from rough_contact.solver.snes import SNESSolver  # noqa: E402
 
 logging.getLogger().addFilter(lambda record: record.levelno >= logging.WARNING)
 
@@ -215,7 +210,7 @@ def run_punch(comm, mesh, order, quadrature, steps, rtol, kind):
     m = punch_demo.build(comm, mesh_size, contact_size, order, load_half_width=2.5, case="b",
                          steps=steps, quadrature_degree=quadrature, normal=normal,
                          seating_steps=DEFAULTS["punch"]["steps"])
-    scene, problem, solver, interface = m["scene"], m["problem"], m["solver"], m["interface"]
+    scene, problem, solver, interface = m.scene, m.problem, m.solver, m.interface
     a = scene.dimensions["half_width"]
     t_mesh = 0.0  # included in t_solve (the demo's build makes mesh and problem together)
     # mean u_z over the load patch (the punch approach)
@@ -259,25 +254,11 @@ def run_beam(comm, mesh, order, quadrature, steps, rtol, kind):
     t_mesh = time.perf_counter() - t0
     normal, t_law = normal_law(comm, "beam", kind, rtol)
     t1 = time.perf_counter()
-    scene, V, bcs = setup["scene"], setup["V"], list(setup["bcs"])
+    scene = setup.scene
     dims = scene.dimensions
-    half_force = beam_demo.TOTAL_FORCE / 2.0
-    p_seat = beam_demo.INITIAL_FORCE / 2.0 / (dims["width"] * dims["half_length"])
-    m00 = beam_demo.CASES[1][0]
-    law = beam_demo.make_law(normal, m00, p_seat, "mindlin", "b")
-    first, _ = scene.contact_pair
-    qdeg = 2 * order if quadrature is None else quadrature
-    interface = ContactInterface(V, scene.facet_tags, first, None, law=law,
-                                 rigid_plane=scene.rigid_plane, grain_direction=beam_demo.GRAIN,
-                                 quadrature_degree=qdeg, bcs=bcs)
-    loads = [SurfaceLoad(scene.tag("load"), force=[0.0, 0.0, -half_force])]
-    problem = ContactProblem(V, {scene.tag("beam"): Material(beam_demo.E1, beam_demo.NU1)}, bcs,
-                             loads, cell_tags=scene.cell_tags, facet_tags=scene.facet_tags,
-                             interface=interface, seating_tag=first, seating_stiffness=1e3)
-    problem.body_cells = [scene.cell_tags.find(scene.tag("beam"))]
-    solver = SNESSolver(problem, prefix="rc_", dof_threshold=200_000)
-    lam0 = beam_demo.INITIAL_FORCE / beam_demo.TOTAL_FORCE
-    factors = [lam0] + [lam0 + (1.0 - lam0) * (i + 1) / steps for i in range(steps)]
+    case = beam_demo.build_case(setup, normal, beam_demo.CASES[1][0], steps, "mindlin", "b",
+                                prefix="rc_", dof_threshold=200_000, quadrature_degree=quadrature)
+    problem, solver, interface, factors = case.problem, case.solver, case.interface, case.factors
     uz0 = None
     newton = 0
     max_err = 0.0

@@ -28,7 +28,7 @@ def main(argv=None):
     import ufl
     from dolfinx import fem
 
-    from meshes.flat_punch import flat_punch
+    from rough_contact.scenes.meshes.flat_punch import flat_punch
     from rough_contact.fem.contact import ContactInterface
     from rough_contact.interface.penalty import SoftplusPenalty
 

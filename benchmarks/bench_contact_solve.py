@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import argparse
 import logging
-import os
 import sys
 
 
@@ -46,12 +45,10 @@ if __name__ == "__main__":
     ARGS, PETSC_ARGS = parse_args(sys.argv[1:])
     petsc4py.init([sys.argv[0]] + PETSC_ARGS)
 
-import numpy as np  # noqa: E402
 from mpi4py import MPI  # noqa: E402
 from petsc4py import PETSc  # noqa: E402
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "demos"))
-import demo_flat_punch as demo  # noqa: E402
+from rough_contact.scenes import flat_punch as demo  # noqa: E402
 
 from rough_contact.solver.loading import load_path  # noqa: E402
 
@@ -72,7 +69,7 @@ def bench_one(comm, mesh_size, contact_size, order, steps, case, dof_threshold, 
                    steps=steps, case=case, prefix=prefix, dof_threshold=dof_threshold,
                    normal_law="elastic")  # table set-up ~1 s; per-iteration cost is the same
     setup = MPI.Wtime() - t0
-    problem, solver = m["problem"], m["solver"]
+    problem, solver = m.problem, m.solver
     problem.reset_timings()
     ksp_event, pc_event = PETSc.Log.Event("KSPSolve"), PETSc.Log.Event("PCSetUp")
     ksp0, pc0 = ksp_event.getPerfInfo()["time"], pc_event.getPerfInfo()["time"]
@@ -86,7 +83,7 @@ def bench_one(comm, mesh_size, contact_size, order, steps, case, dof_threshold, 
     ksp = comm.allreduce(ksp_event.getPerfInfo()["time"] - ksp0, op=MPI.MAX)
     pcs = comm.allreduce(pc_event.getPerfInfo()["time"] - pc0, op=MPI.MAX)
     tm = {k: comm.allreduce(v, op=MPI.MAX) for k, v in problem.timings.items()}
-    row = dict(dofs=problem.num_dofs, points=m["interface"].n_points_global, its=its,
+    row = dict(dofs=problem.num_dofs, points=m.interface.n_points_global, its=its,
                setup=setup, bulk_setup=problem.setup_time, total=solve,
                bulk=tm["bulk"] / n_it,
                interface=(tm["interface_residual"] + tm["interface_jacobian"]) / n_it,

@@ -30,244 +30,18 @@
 #
 # The results table is written to ``<outdir>/punch_cases.json`` and printed.
 
+
 from __future__ import annotations
 
 import argparse
 import json
 import os
-import sys
 import time
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import demo_flat_punch as demo  # noqa: E402  (initialises petsc4py before dolfinx)
+from mpi4py import MPI
 
-import numpy as np  # noqa: E402
-from mpi4py import MPI  # noqa: E402
-
-from rough_contact.solver.loading import load_path, load_unload_factors  # noqa: E402
-from rough_contact.solver.output import gather_points  # noqa: E402
-
-FLIP = np.array([1.0, -1.0])  # local (x, y) -> global (x, y): y_local = n x x = -y_global
-
-
-def snapshot(comm, interface):
-    """Global (gathered on rank 0) point fields in GLOBAL x, y axes; None on other ranks.
-
-    Keys: x (n, 2) [mm], w (n,) [mm^2], t (n, 2) tangential traction on the punch surface
-    (energy-conjugate, t = dpsi/djump; the force per area on the punch is +t) [MPa],
-    sp (n, 2) plastic slip (u_foundation - u_punch) [mm], s (n, 2) total slip [mm],
-    p (n,) pressure [MPa], slipping (n,) bool, D (n,) cumulative dissipation per area [N/mm].
-    """
-    pf = interface.point_fields()
-    pts, f = gather_points(comm, interface.point_coordinates(), {
-        "w": pf.weight, "t": pf.shear * FLIP, "sp": pf.plastic_slip * FLIP,
-        "s": pf.slip * FLIP, "p": pf.pressure, "slipping": pf.slipping.astype(float),
-        "D": pf.dissipation})
-    if comm.rank != 0:
-        return None
-    f["x"] = pts[:, :2]
-    f["slipping"] = f["slipping"] > 0.5
-    return f
-
-
-def mirror_asymmetry(snap, tol=1e-7):
-    """Relative x <-> y mirror defect of the plastic slip and the traction (rank 0).
-
-    Each point (x, y) is paired with the point nearest to (y, x); a vector field v is
-    symmetric when v(y, x) = (v_y, v_x)(x, y). Returns (max pairing distance [mm],
-    defect of sp, defect of t), defects as max |difference| / max |field|.
-    """
-    from scipy.spatial import cKDTree
-
-    x = snap["x"]
-    dist, j = cKDTree(x).query(x[:, ::-1])
-    out = [float(dist.max())]
-    for key in ("sp", "t"):
-        v = snap[key]
-        scale = np.abs(v).max()
-        out.append(float(np.abs(v[j] - v[:, ::-1]).max() / scale) if scale > 0 else 0.0)
-    return tuple(out)
-
-
-def run_case(case, comm=MPI.COMM_WORLD, mesh_size=10.0, contact_size=1.0, order=1,
-             cell_type="hexahedron", load_half_width=2.5, steps=16, n_unload=None,
-             final_factor=None, normal_law="elasto-plastic", prefix="punch_case_", verbose=False):
-    """One friction case through loading and unloading. Collective.
-
-    Loading in ``steps`` increments to 1000 N, then ``n_unload`` (default steps - 1) increments
-    down to the load factor ``final_factor`` (default 1/steps).
-
-    Returns (identical keys on every rank; snapshots only on rank 0, else None):
-        dict with case, num_dofs, n_points, wall_time [s], D_peak, D_end (cumulative, quarter
-        model) [N mm], D_literal_peak (sum t_T . u^p_T w at peak) [N mm], max_plastic_slip_peak
-        [mm], slip_area_fraction_peak [-] (slipping area / patch area), history (list of
-        per-increment dicts: load_factor, n_slipping, D, reversed_fraction, Fx, Fy), peak and
-        end snapshots (see ``snapshot``), first_reversal_load_factor (largest load factor on
-        unloading at which some contact area has its traction reversed; nan if none).
-    """
-    t0 = MPI.Wtime()
-    n_unload = steps - 1 if n_unload is None else n_unload
-    m = demo.build(comm=comm, mesh_size=mesh_size, contact_size=contact_size, order=order,
-                   load_half_width=load_half_width, law="rough", case=case,
-                   normal_law=normal_law, steps=steps, prefix=prefix, cell_type=cell_type)
-    interface, problem, solver = m["interface"], m["problem"], m["solver"]
-    factors = load_unload_factors(steps, n_unload, final_factor)
-    history, peak, snap = [], None, None
-    for inc in load_path(problem, solver, factors, verbose=verbose):
-        if not np.isclose(inc.contact_force[2], -inc.applied_force[2], rtol=1e-6):
-            raise RuntimeError(f"force balance violated at load factor {inc.load_factor}")
-        snap = snapshot(comm, interface)
-        row = dict(load_factor=inc.load_factor, n_slipping=inc.n_slipping,
-                   D=inc.dissipation, Fx=float(inc.contact_force[0]),
-                   Fy=float(inc.contact_force[1]), iterations=inc.iterations,
-                   reversed_fraction=float("nan"))
-        if inc.load_factor == 1.0 and inc.target == 1.0:
-            peak = snap
-        elif peak is not None and comm.rank == 0:
-            # contact area whose traction points against its peak-load direction
-            rev = np.einsum("ij,ij->i", snap["t"], peak["t"]) < 0.0
-            row["reversed_fraction"] = float(snap["w"][rev].sum() / snap["w"].sum())
-        history.append(row)
-    D_end = interface.dissipation()
-    D_peak = next(r["D"] for r in history if r["load_factor"] == 1.0)
-    res = dict(case=case, num_dofs=problem.num_dofs, n_points=interface.n_points_global,
-               cell_type=cell_type, mesh_size=mesh_size, contact_size=contact_size,
-               order=order, steps=steps, n_unload=n_unload, normal_law=normal_law,
-               D_peak=D_peak, D_end=D_end, history=history, peak=peak, end=snap)
-    if comm.rank == 0:
-        area = peak["w"].sum()
-        res["D_literal_peak"] = float(np.sum(np.einsum("ij,ij->i", peak["t"], peak["sp"])
-                                             * peak["w"]))
-        res["max_plastic_slip_peak"] = float(np.linalg.norm(peak["sp"], axis=1).max())
-        res["mean_plastic_slip_peak"] = float(
-            np.sum(np.linalg.norm(peak["sp"], axis=1) * peak["w"]) / area)
-        res["slip_area_fraction_peak"] = float(peak["w"][peak["slipping"]].sum() / area)
-        rev = [r["load_factor"] for r in history
-               if np.isfinite(r["reversed_fraction"]) and r["reversed_fraction"] > 0]
-        res["first_reversal_load_factor"] = max(rev) if rev else float("nan")
-        res["reversed_fraction_end"] = history[-1]["reversed_fraction"]
-        # of the area whose traction reversed, the part whose total slip kept its peak sign
-        rev_end = np.einsum("ij,ij->i", snap["t"], peak["t"]) < 0.0
-        kept = rev_end & (np.einsum("ij,ij->i", snap["s"], peak["s"]) > 0.0)
-        res["slip_sign_kept_fraction"] = (float(snap["w"][kept].sum() / snap["w"][rev_end].sum())
-                                          if rev_end.any() else float("nan"))
-        res["mirror_peak"] = mirror_asymmetry(peak)
-        res["mirror_end"] = mirror_asymmetry(snap)
-    res = comm.bcast({k: (v if k not in ("peak", "end") else None) for k, v in res.items()}
-                     if comm.rank == 0 else None, root=0) | {"peak": peak, "end": snap}
-    solver.destroy()
-    res["wall_time"] = MPI.Wtime() - t0
-    return res
-
-
-# ## Figures (rank 0)
-def _quiver(ax, snap, title, n_grid=10):
-    """Plastic slip directions at about n_grid^2 points (the paper shows 81 / 100 nodes)."""
-    from scipy.spatial import cKDTree
-
-    x = snap["x"]
-    a = float(x.max())
-    g = (np.arange(n_grid) + 0.5) * a / n_grid
-    gx, gy = np.meshgrid(g, g)
-    idx = np.unique(cKDTree(x).query(np.column_stack([gx.ravel(), gy.ravel()]))[1])
-    sp = snap["sp"][idx]
-    mag = np.linalg.norm(sp, axis=1)
-    big = mag > 1e-3 * max(mag.max(), 1e-300)
-    unit = np.where(big[:, None], sp / np.maximum(mag, 1e-300)[:, None], 0.0)
-    q = ax.quiver(x[idx, 0], x[idx, 1], unit[:, 0], unit[:, 1], mag * 1e6, cmap="viridis",
-                  pivot="tail", scale=n_grid * 1.4, scale_units="width")
-    ax.plot(x[idx[~big], 0], x[idx[~big], 1], "k.", ms=3)
-    ax.set_xlim(0, a * 1.08)
-    ax.set_ylim(0, a * 1.08)
-    ax.set_aspect("equal")
-    ax.set_xlabel("x (grain) [mm]")
-    ax.set_ylabel("y [mm]")
-    ax.set_title(title, fontsize=9)
-    return q
-
-
-def plot_case(res, path):
-    """Three panels: plastic slip directions at peak, after unloading; stick/slip at peak."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, axs = plt.subplots(1, 3, figsize=(15, 4.8))
-    for ax, key, when in ((axs[0], "peak", "at 1000 N"), (axs[1], "end", "after unloading")):
-        q = _quiver(ax, res[key], f"case ({res['case']}): plastic slip directions {when}")
-        fig.colorbar(q, ax=ax, label="|plastic slip| [nm]", shrink=0.85)
-    pk = res["peak"]
-    x = pk["x"]
-    ax = axs[2]
-    ax.scatter(x[~pk["slipping"], 0], x[~pk["slipping"], 1], s=3, c="tab:blue", label="stick")
-    ax.scatter(x[pk["slipping"], 0], x[pk["slipping"], 1], s=3, c="tab:red", label="slip")
-    ax.set_aspect("equal")
-    ax.set_xlim(0, x.max() * 1.08)
-    ax.set_ylim(0, x.max() * 1.08)
-    ax.set_xlabel("x (grain) [mm]")
-    ax.set_ylabel("y [mm]")
-    ax.legend(loc="upper right", fontsize=8, markerscale=3, framealpha=0.9)
-    ax.set_title(f"case ({res['case']}): stick/slip at 1000 N "
-                 f"(slip on {100 * res['slip_area_fraction_peak']:.0f} % of the patch)", fontsize=9)
-    fig.suptitle("Quarter punch, patch [0,10]^2 mm (centre at the origin); arrows: direction of "
-                 "u^p_T (foundation - punch), colour: magnitude", fontsize=9)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-
-
-def plot_unloading(results, path):
-    """Reversed-traction area fraction and tangential resultant Fx vs load factor."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, axs = plt.subplots(1, 2, figsize=(11, 4))
-    for res in results:
-        h = res["history"]
-        lam = np.array([r["load_factor"] for r in h])
-        n_load = res["steps"]
-        un = np.arange(len(h)) >= n_load - 1  # peak and the unloading steps
-        rf = np.array([0.0 if not np.isfinite(r["reversed_fraction"]) else r["reversed_fraction"]
-                       for r in h])
-        axs[0].plot(lam[un], 100 * rf[un], "o-", ms=3, label=f"case ({res['case']})")
-        fx = np.array([r["Fx"] for r in h])
-        fy = np.array([r["Fy"] for r in h])
-        axs[1].plot(lam, fx, "-", label=f"case ({res['case']}) Fx")
-        axs[1].plot(lam, fy, "--", label=f"case ({res['case']}) Fy")
-    axs[0].set_xlabel("load factor on unloading (1 = 1000 N)")
-    axs[0].set_ylabel("contact area with reversed t_T [%]")
-    axs[0].invert_xaxis()
-    axs[0].legend(fontsize=8)
-    axs[0].set_title("tangential traction opposite to its peak-load direction", fontsize=9)
-    axs[1].set_xlabel("load factor")
-    axs[1].set_ylabel("tangential resultant on the quarter punch [N]")
-    axs[1].legend(fontsize=7)
-    axs[1].set_title("tangential interface force (loading and unloading)", fontsize=9)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-
-
-def summary_table(results):
-    """Markdown table of the measured figures beside Table 5 (rank 0)."""
-    lines = ["| case | D_cum peak (quarter) | D_cum end (quarter) | D_lit peak (quarter) | "
-             "x4 (whole punch, D_cum end) | Table 5 21-node | Table 5 28-node | "
-             "max u^p peak [um] | slip area peak | reversed t_T area end | mirror defect sp peak "
-             "| slip sign kept (reversed area) | DOFs / points | wall [s] |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
-    for r in results:
-        c = r["case"]
-        lines.append(
-            f"| ({c}) | {r['D_peak']:.3e} | {r['D_end']:.3e} | {r['D_literal_peak']:.3e} | "
-            f"{4 * r['D_end']:.3e} | {demo.TABLE5['21-node'][c]} | {demo.TABLE5['28-node'][c]} | "
-            f"{r['max_plastic_slip_peak'] * 1e3:.4f} | {100 * r['slip_area_fraction_peak']:.1f} % "
-            f"| {100 * r['reversed_fraction_end']:.1f} % | {r['mirror_peak'][1]:.2e} | "
-            f"{100 * r['slip_sign_kept_fraction']:.1f} % | {r['num_dofs']} / {r['n_points']} | "
-            f"{r['wall_time']:.1f} |")
-    return "\n".join(lines)
+from rough_contact.scenes import flat_punch as punch
+from rough_contact.scenes.punch_cases import plot_case, plot_unloading, run_case, summary_table
 
 
 def main(argv=None, comm=MPI.COMM_WORLD):
@@ -296,7 +70,7 @@ def main(argv=None, comm=MPI.COMM_WORLD):
         if comm.rank == 0:
             print(f"case ({case}): D_cum peak {res['D_peak']:.4e}, end {res['D_end']:.4e}, "
                   f"D_lit peak {res['D_literal_peak']:.4e} N mm (quarter); Table 5: "
-                  f"{demo.TABLE5['21-node'][case]} / {demo.TABLE5['28-node'][case]}; "
+                  f"{punch.TABLE5['21-node'][case]} / {punch.TABLE5['28-node'][case]}; "
                   f"{res['num_dofs']} DOFs, {res['n_points']} points, "
                   f"{res['wall_time']:.1f} s", flush=True)
     if comm.rank == 0:
@@ -319,3 +93,4 @@ if __name__ == "__main__":
 
     abort_on_uncaught_exception()  # one failing rank must not leave the others waiting
     main()
+

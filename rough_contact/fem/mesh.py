@@ -1,6 +1,6 @@
 """gmsh model -> one DOLFINx mesh holding every body of a contact scene.
 
-Units: whatever the gmsh model uses; the scenes in ``meshes/`` are in mm.
+Units: whatever the gmsh model uses; the scenes in ``rough_contact/scenes/meshes/`` are in mm.
 
 The bodies are meshed together in gmsh after an OCC ``fragment``, so that their contact
 faces share one conforming surface mesh. Before the mesh reaches DOLFINx, the nodes that
@@ -635,7 +635,7 @@ def scene_cli(builder, float_options, argv=None, description=None) -> Scene:
     """Command line of a scene builder: build it, print labels and measures, optionally XDMF.
 
     Args:
-        builder: a collective scene builder (``meshes.flat_punch.flat_punch`` ...).
+        builder: a collective scene builder (``rough_contact.scenes.meshes.flat_punch.flat_punch`` ...).
         float_options: names of the builder's float keywords exposed as ``--name`` options
             (underscores become dashes).
         argv: arguments (default ``sys.argv[1:]``).

@@ -13,14 +13,12 @@ Units: mm, N, MPa.
 from __future__ import annotations
 
 import os
-import sys
 
 import numpy as np
 import pytest
 from mpi4py import MPI
 
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "demos"))
-import demo_beam_rigid_base as demo  # noqa: E402
+from rough_contact.scenes import beam as demo  # noqa: E402
 
 TINY = dict(mesh_size=60.0, contact_size=10.0, order=1, steps=4, plot=False, xdmf=False,
             verbose=False)
@@ -34,7 +32,7 @@ def _outdir(comm, tmp_path_factory):
 @pytest.fixture(scope="module")
 def world(tmp_path_factory):
     comm = MPI.COMM_WORLD
-    return demo.main(cases=(1, 3), outdir=_outdir(comm, tmp_path_factory), comm=comm,
+    return demo.run(cases=(1, 3), outdir=_outdir(comm, tmp_path_factory), comm=comm,
                      prefix="beamtest_", **TINY)
 
 
@@ -68,7 +66,7 @@ def test_one_vs_two_ranks(world, tmp_path_factory):
     if comm.size == 1:
         pytest.skip("run with mpirun -n 2 to compare partitions")
     path = os.path.join(_outdir(comm, tmp_path_factory), f"self{comm.rank}")
-    serial = demo.main(cases=(1, 3), outdir=path, comm=MPI.COMM_SELF, prefix="beamself_",
+    serial = demo.run(cases=(1, 3), outdir=path, comm=MPI.COMM_SELF, prefix="beamself_",
                        **TINY)
     for a, b in zip(world, serial):
         scale = max(abs(a["centre"]), abs(a["end"]))
@@ -83,7 +81,7 @@ def test_frictionless_ends_lift_more(world, tmp_path_factory):
     more and its ends move further from the base; the force balance still holds (the x
     rigid motion is then fixed on the mid-plane)."""
     comm = MPI.COMM_WORLD
-    free = demo.main(cases=(1,), friction="none", outdir=_outdir(comm, tmp_path_factory),
+    free = demo.run(cases=(1,), friction="none", outdir=_outdir(comm, tmp_path_factory),
                      comm=comm, prefix="beamfree_", **TINY)[0]
     with_friction = next(r for r in world if r["case"] == 1)
     assert free["end"] > with_friction["end"]
@@ -99,7 +97,7 @@ def test_rigid_beam_limit(tmp_path_factory):
     comm = MPI.COMM_WORLD
     errors = []
     for factor in (1e3, 1e4):
-        r = demo.main(cases=(1,), beam_modulus=demo.E1 * factor, prefix="beamrigid_",
+        r = demo.run(cases=(1,), beam_modulus=demo.E1 * factor, prefix="beamrigid_",
                       outdir=_outdir(comm, tmp_path_factory), comm=comm, **TINY)[0]
         law = demo.make_normal_law(MPI.COMM_SELF, 0.625, "elastic")
         p_seat = demo.INITIAL_FORCE / 5000.0
@@ -114,6 +112,6 @@ def test_rigid_beam_limit(tmp_path_factory):
 
 def test_bad_arguments_rejected():
     with pytest.raises(ValueError, match="cases"):
-        demo.main(cases=(7,), comm=MPI.COMM_WORLD, **TINY)
+        demo.run(cases=(7,), comm=MPI.COMM_WORLD, **TINY)
     with pytest.raises(ValueError, match="friction"):
-        demo.main(cases=(1,), friction="coulomb", comm=MPI.COMM_WORLD, **TINY)
+        demo.run(cases=(1,), friction="coulomb", comm=MPI.COMM_WORLD, **TINY)

@@ -402,7 +402,7 @@ GMSH_CASES = [("tetrahedron", 1), ("tetrahedron", 2), ("hexahedron", 1), ("hexah
 @pytest.mark.parametrize("cell_type,order", GMSH_CASES)
 def test_uniform_jump_patch_gmsh_scene(cell_type, order):
     """(c) on D1's two_blocks (curved-capable P2 geometry, hexahedra): force = -k d area."""
-    blocks = pytest.importorskip("meshes.blocks")
+    blocks = pytest.importorskip("rough_contact.scenes.meshes.blocks")
     lx, ly = 1.0, 0.8
     sc = blocks.two_blocks(lx=lx, ly=ly, h1=0.4, h2=0.4, mesh_size=0.35, order=order,
                            cell_type=cell_type)
@@ -425,7 +425,7 @@ def test_uniform_jump_patch_gmsh_scene(cell_type, order):
 @pytest.mark.parametrize("cell_type,order", GMSH_CASES)
 def test_against_ufl_gmsh_block_on_plane(cell_type, order):
     """(a) on D1's block_on_plane with its rigid plane: same vector and matrix as UFL."""
-    blocks = pytest.importorskip("meshes.blocks")
+    blocks = pytest.importorskip("rough_contact.scenes.meshes.blocks")
     sc = blocks.block_on_plane(lx=1.0, ly=0.7, h=0.5, mesh_size=0.3, order=order,
                                cell_type=cell_type)
     V = fem.VectorFunctionSpace(sc.mesh, ("Lagrange", order))

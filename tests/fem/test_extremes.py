@@ -35,19 +35,13 @@ import numpy as np
 import pytest
 from mpi4py import MPI
 
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "demos"))
-import demo_flat_punch as demo  # noqa: E402  (initialises petsc4py before dolfinx)
+from rough_contact.scenes import flat_punch as demo  # noqa: E402
 
 from petsc4py import PETSc  # noqa: E402
 
-from dolfinx import fem  # noqa: E402
-
-from meshes.flat_punch import flat_punch  # noqa: E402
-from rough_contact.fem.contact import ContactInterface  # noqa: E402
-from rough_contact.fem.problem import ContactProblem, Material, SurfaceLoad  # noqa: E402
+from rough_contact.interface.contract import ConvergenceError  # noqa: E402
 from rough_contact.solver.loading import LoadStepError, load_path, load_unload_factors  # noqa: E402
 from rough_contact.solver.output import ResultWriter  # noqa: E402
-from rough_contact.solver.snes import SNESSolver  # noqa: E402
 
 # Coarse scene: ~1 s per Newton solve sequence on one core.
 MESH = dict(mesh_size=20.0, contact_size=2.5, order=1, load_half_width=2.5)
@@ -99,7 +93,8 @@ class Case:
 
 
 class FailingLaw:
-    """Wraps an interface law; once ``p_limit`` is set, a pressure above it raises ValueError.
+    """Wraps an interface law; once ``p_limit`` is set, a pressure above it raises a
+    ConvergenceError (the failure type that makes the load stepping cut back).
 
     Used to drive the load path deterministically into its clean stop (cutback down to the
     minimum increment, then LoadStepError), independently of round-off.
@@ -116,7 +111,7 @@ class FailingLaw:
         res = self.law.evaluate(jump, committed)
         p_max = float(np.max(-res.traction[:, 0], initial=0.0))
         if p_max > self.p_limit:
-            raise ValueError(f"forced failure: pressure {p_max:.4g} MPa above the limit "
+            raise ConvergenceError(f"forced failure: pressure {p_max:.4g} MPa above the limit "
                              f"{self.p_limit:.4g} MPa")
         return res
 
@@ -196,22 +191,8 @@ class Scene:
 
     def __init__(self, comm):
         self.comm = comm
-        self.scene = flat_punch(comm=comm, **MESH)
-        sc = self.scene
-        self.V = fem.VectorFunctionSpace(sc.mesh, ("Lagrange", MESH["order"]))
-        fdim = sc.mesh.topology.dim - 1
-
-        def dofs(name, comp=None):
-            facets = sc.facet_tags.find(sc.tag(name))
-            if comp is None:
-                return fem.locate_dofs_topological(self.V, fdim, facets)
-            return fem.locate_dofs_topological(self.V.sub(comp), fdim, facets)
-
-        zero = PETSc.ScalarType(0.0)
-        V = self.V
-        self.bcs = [fem.dirichletbc(zero, dofs("symmetry_x", 0), V.sub(0)),
-                    fem.dirichletbc(zero, dofs("symmetry_y", 1), V.sub(1)),
-                    fem.dirichletbc(np.zeros(3, dtype=PETSc.ScalarType), dofs("fixed"), V)]
+        self.punch = demo.quarter_punch(comm, **MESH)
+        self.scene = sc = self.punch.scene
         self.contact_area = sc.dimensions["half_width"] ** 2
         self._normal_cache: dict = {}
         self.n_runs = 0
@@ -263,26 +244,17 @@ class Scene:
     def run(self, case: Case, outdir: str) -> Outcome:
         """Load/unload the punch with ``case``'s law; write history.csv in ``outdir``."""
         comm = self.comm
-        sc = self.scene
         t0 = time.perf_counter()
-        quarter_force = demo.TOTAL_FORCE / 4.0 * case.load_scale
+        quarter_force = demo.TOTAL_FORCE * case.load_scale / 4.0
         p_seat = quarter_force / N_LOAD / self.contact_area  # seat with the first increment
         law = self.interface_law(case, p_seat)
-        first, second = sc.contact_pair
-        interface = ContactInterface(self.V, sc.facet_tags, first, second, law=law,
-                                     grain_direction=(1.0, 0.0, 0.0),
-                                     quadrature_degree=2 * MESH["order"], bcs=self.bcs)
-        materials = {sc.tag("punch"): Material(demo.E, demo.NU),
-                     sc.tag("foundation"): Material(demo.E, demo.NU)}
-        loads = [SurfaceLoad(sc.tag("load"), force=[0.0, 0.0, -quarter_force])]
-        problem = ContactProblem(self.V, materials, self.bcs, loads, cell_tags=sc.cell_tags,
-                                 facet_tags=sc.facet_tags, interface=interface,
-                                 seating_tag=first, seating_stiffness=1e3)
-        # A fresh options prefix per run: the solver's defaults (snes_atol ~ |f|) are set only
-        # where absent, so a shared prefix would keep the first run's absolute tolerance.
+        # A fresh options prefix per run (the solver removes its defaults after use, so this
+        # only keeps the runs' command-line options apart).
         self.n_runs += 1
-        solver = SNESSolver(problem, prefix=f"rcext{self.n_runs}_",
-                            defaults={"snes_max_it": SNES_MAX_IT})
+        m = demo.build(comm, law=law, steps=N_LOAD, prefix=f"rcext{self.n_runs}_",
+                       punch_scene=self.punch, total_force=demo.TOTAL_FORCE * case.load_scale,
+                       solver_defaults={"snes_max_it": SNES_MAX_IT})
+        interface, problem, solver = m.interface, m.problem, m.solver
         # count every Newton solve and its outcome (a failed one is followed by a cutback)
         attempts = []
         solve = solver.solve

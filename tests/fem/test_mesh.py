@@ -14,9 +14,9 @@ import numpy as np
 import pytest
 from mpi4py import MPI
 
-from meshes.beam import beam_on_base
-from meshes.blocks import block_on_plane, two_blocks
-from meshes.flat_punch import flat_punch
+from rough_contact.scenes.meshes.beam import beam_on_base
+from rough_contact.scenes.meshes.blocks import block_on_plane, two_blocks
+from rough_contact.scenes.meshes.flat_punch import flat_punch
 from rough_contact.fem.mesh import (add_groups, build_scene, check_conformity, entity_centers,
                                     facet_vertex_coordinates, measure_of, owned_facets)
 

@@ -12,7 +12,7 @@ from petsc4py import PETSc
 
 from dolfinx import fem
 
-from meshes.blocks import block_on_plane
+from rough_contact.scenes.meshes.blocks import block_on_plane
 from rough_contact.fem.problem import ContactProblem, Material, SurfaceLoad, rigid_body_modes
 from rough_contact.solver.snes import SNESSolver
 
@@ -99,7 +99,7 @@ def test_bad_input_raises():
 # ----------------------------------------------------------------------------------------------
 # two blocks: patch tests and force balance
 # ----------------------------------------------------------------------------------------------
-from meshes.blocks import two_blocks  # noqa: E402
+from rough_contact.scenes.meshes.blocks import two_blocks  # noqa: E402
 from rough_contact.fem.contact import ContactInterface  # noqa: E402
 from rough_contact.interface.contract import ConvergenceError  # noqa: E402
 from rough_contact.interface.penalty import LinearPenalty  # noqa: E402

@@ -6,14 +6,12 @@ Serial and ``mpirun -n 2``. Units: mm, N, MPa.
 from __future__ import annotations
 
 import os
-import sys
 
 import numpy as np
 import pytest
 from mpi4py import MPI
 
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "demos"))
-import demo_flat_punch as demo  # noqa: E402
+from rough_contact.scenes import flat_punch as demo  # noqa: E402
 
 from rough_contact.solver.loading import load_path, load_unload_factors  # noqa: E402
 
@@ -23,7 +21,7 @@ COARSE = dict(mesh_size=20.0, contact_size=2.5, order=1, normal_law="elastic")
 
 def run_punch(comm, steps=4, n_unload=1, prefix="test_punch_"):
     m = demo.build(comm=comm, steps=steps, prefix=prefix, **COARSE)
-    incs = list(load_path(m["problem"], m["solver"], load_unload_factors(steps, n_unload),
+    incs = list(load_path(m.problem, m.solver, load_unload_factors(steps, n_unload),
                           verbose=False))
     return m, incs
 
@@ -45,16 +43,16 @@ def test_newton_quadratic_rough_orthotropic_friction():
                 assert r[k + 1] <= 10.0 * r[k] ** 2, (inc.step, r.tolist())
         # normal force balance at every converged increment
         assert np.isclose(inc.contact_force[2], -inc.applied_force[2], rtol=1e-8)
-    m["solver"].destroy()
+    m.solver.destroy()
 
 
 def test_punch_results_do_not_depend_on_rank_count():
     """Integrated quantities on all ranks equal the serial (COMM_SELF) run to 1e-8."""
     comm = MPI.COMM_WORLD
     m_par, par = run_punch(comm, prefix="test_par_")
-    D_par = m_par["interface"].dissipation()
+    D_par = m_par.interface.dissipation()
     m_ser, ser = run_punch(MPI.COMM_SELF, prefix="test_ser_")
-    D_ser = m_ser["interface"].dissipation()
+    D_ser = m_ser.interface.dissipation()
     for a, b in zip(par, ser):
         assert a.n_active == b.n_active and a.n_slipping == b.n_slipping
         assert np.allclose(a.contact_force, b.contact_force, rtol=1e-8,
@@ -62,14 +60,14 @@ def test_punch_results_do_not_depend_on_rank_count():
         assert np.isclose(a.real_area, b.real_area, rtol=1e-8)
     assert D_ser > 0.0
     assert np.isclose(D_par, D_ser, rtol=1e-8)
-    m_par["solver"].destroy()
-    m_ser["solver"].destroy()
+    m_par.solver.destroy()
+    m_ser.solver.destroy()
 
 
 def test_demo_main_small(tmp_path):
     comm = MPI.COMM_WORLD
     outdir = comm.bcast(str(tmp_path), root=0)
-    res = demo.main(mesh_size=20.0, contact_size=5.0, order=1, steps=2, outdir=outdir, comm=comm,
+    res = demo.run(mesh_size=20.0, contact_size=5.0, order=1, steps=2, outdir=outdir, comm=comm,
                     normal_law="elastic",
                     prefix="test_demo_", verbose=False)
     assert res["max_force_error"] < 1e-8

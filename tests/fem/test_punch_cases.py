@@ -15,15 +15,12 @@ Serial and ``mpirun -n 2``. Units: mm, N, MPa.
 
 from __future__ import annotations
 
-import os
-import sys
 
 import numpy as np
 import pytest
 from mpi4py import MPI
 
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "demos"))
-import study_flat_punch_cases as study  # noqa: E402
+from rough_contact.scenes import punch_cases as study
 
 # coarse structured hexahedra (mirror-symmetric about x = y); elastic population: fast table
 COARSE = dict(mesh_size=25.0, contact_size=2.5, cell_type="hexahedron", steps=4, n_unload=5,

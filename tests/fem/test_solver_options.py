@@ -13,7 +13,7 @@ import pytest
 from petsc4py import PETSc
 
 from dolfinx import fem
-from meshes.blocks import block_on_plane
+from rough_contact.scenes.meshes.blocks import block_on_plane
 from rough_contact.fem.problem import ContactProblem, Material, SurfaceLoad
 from rough_contact.solver.options import unused_options
 from rough_contact.solver.snes import SNESSolver, UnusedOptionsWarning

@@ -1,0 +1,361 @@
+"""The paper's flat punch (section 9.2): a square punch pressed on an elastic foundation across
+a rough, orthotropic-frictional interface — parameters, laws, set-up and the standard run.
+
+Buczkowski & Kleiber (2009), section 9.2: a flat-ended square punch (20 x 20 x 10 mm) on an
+elastic foundation (100 x 100 x 50 mm), E = 200 GPa and nu = 0.25 for both, 1000 N in sixteen
+increments, then unloaded; the rough surface of Figs 18-19 (m00 = 0.625 um^2, m20 = 8e-5,
+m02 = 8e-4, m40 = 1.04e-6 um^-2, m04 = 1.04e-4 um^-2) and the orthotropic slip-hardening friction
+of Fig 18, cases (a), (b), (c). A quarter is modelled (symmetry planes x = 0 and y = 0); it
+carries 250 N on a central square of the punch top.
+
+The rough surfaces are seated: the reference separation h0 at zero gap carries the nominal
+pressure of the first load increment (h = h0 + g). Defaults (P2, 20 mm away from / 2 mm on the
+contact) are the 1 % settings of ``docs/accuracy_vs_cost.md``.
+
+Library code: it never initialises petsc4py and never reads ``sys.argv`` (the entry script
+``demos/demo_flat_punch.py`` does). Units: mm, N, MPa.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+from dataclasses import dataclass
+from typing import Optional
+
+import numpy as np
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from dolfinx import fem
+
+from rough_contact.fem.contact import ContactInterface
+from rough_contact.fem.mesh import Scene
+from rough_contact.fem.problem import ContactProblem, Material, SurfaceLoad
+from rough_contact.interface.contract import InterfaceLawProtocol
+from rough_contact.scenes.meshes.flat_punch import flat_punch
+from rough_contact.solver.loading import load_path, load_unload_factors
+from rough_contact.solver.output import ResultWriter, gather_points
+from rough_contact.solver.snes import SNESSolver
+from rough_contact.validation import check_scalar
+
+__all__ = ["E", "NU", "TOTAL_FORCE", "MOMENTS_UM", "FRICTION_CASES", "HARDENING", "TABLE5",
+           "PLASTIC", "effective_modulus", "make_law", "PunchScene", "quarter_punch", "PunchModel",
+           "build", "point_data",
+           "plot_slip_directions", "run"]
+
+# Silence the INFO lines of the JIT compiler (setuptools resets the root logger's level).
+logging.getLogger().addFilter(lambda record: record.levelno >= logging.WARNING)
+
+# ## Parameters of the paper
+E, NU = 2.0e5, 0.25  # both bodies [MPa], [-]
+TOTAL_FORCE = 1000.0  # full punch [N]; the quarter model carries a quarter
+MOMENTS_UM = dict(m00=0.625, m20=8e-5, m02=8e-4, m40=1.04e-6, m04=1.04e-4)  # paper's um units
+# Fig 18 friction cases: (mu_m, mu_o ratio, potential axes nu, kT/kN per axis)
+FRICTION_CASES = {
+    "a": dict(mu_macro=(0.2, 0.2), mu_initial_ratio=(1.0, 1.0), nu=(0.125, 0.125), kt=(0.7, 0.7)),
+    "b": dict(mu_macro=(0.5, 0.5), mu_initial_ratio=(0.5, 0.5), nu=(0.125, 0.125), kt=(0.7, 0.7)),
+    "c": dict(mu_macro=(0.5, 0.5), mu_initial_ratio=(0.5, 0.5), nu=(0.125, 0.125), kt=(0.7, 1.0)),
+}
+HARDENING = (275.0, 275.0)  # n_x, n_y [1/mm]
+# Table 5: total frictional dissipation D [N mm] for cases (a), (b), (c)
+TABLE5 = {"21-node": {"a": 0.2478, "b": 0.2540, "c": 0.0150},
+          "28-node": {"a": 0.2114, "b": 0.1868, "c": 0.0162}}
+# Elasto-plastic asperity data of Figs 18-19 (used with --normal-law elasto-plastic)
+PLASTIC = dict(Y=2070.0, K_Y=1.62, psi=0.35, ch=0.967, omega_p_ratio=45.0)
+
+
+def effective_modulus(E1, nu1, E2, nu2):
+    """E* of eq (42): 1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2 [MPa]."""
+    return 1.0 / ((1.0 - nu1**2) / E1 + (1.0 - nu2**2) / E2)
+
+
+# ## Interface law
+#
+# The normal law is tabulated once from the population sums (rank 0 builds it, the others get a
+# copy); the friction law is the orthotropic slip-hardening model with Mindlin-type tangential
+# stiffness kT = c kN.  ``law="penalty"`` gives a smooth unilateral penalty with Coulomb friction
+# instead (a stand-in for debugging the FE layer).
+def make_law(comm, law="rough", case="b", normal_law="elastic", seating_pressure=None,
+             normal=None):
+    """Interface law and its normal law; ``normal`` (a prebuilt NormalLaw) skips the build."""
+    from rough_contact.interface.friction import OrthotropicSlipHardening
+    from rough_contact.interface.law import InterfaceLaw
+    from rough_contact.interface.penalty import SoftplusPenalty
+    from rough_contact.interface.tangential import TangentialStiffness
+
+    if law == "penalty":
+        return SoftplusPenalty(k_normal=1e5, width=1e-4, k_tangential=7e4, friction=0.5), None
+    if law != "rough":
+        raise ValueError(f"law = {law!r} is invalid; valid values: 'rough', 'penalty'")
+    if case not in FRICTION_CASES and case != "none":
+        raise ValueError(f"friction case = {case!r} is invalid; valid: a, b, c, none")
+    if normal_law not in ("elastic", "elasto-plastic"):  # checked on every rank: no hang
+        raise ValueError(f"normal_law = {normal_law!r} is invalid; valid values: "
+                         "'elastic', 'elasto-plastic'")
+    if normal is None:
+        if comm.rank == 0:  # the table is built once and copied to the other ranks
+            from rough_contact.asperity import AsperityMaterial
+            from rough_contact.interface.normal import NormalLaw
+            from rough_contact.surface import SpectralMoments
+
+            surface = SpectralMoments(**MOMENTS_UM, unit="um")
+            E_star = effective_modulus(E, NU, E, NU)
+            if normal_law == "elastic":
+                normal = NormalLaw.elastic(surface, E_star)
+            else:
+                normal = NormalLaw.elasto_plastic(
+                    surface, AsperityMaterial(E_star=E_star, nu=NU, **PLASTIC))
+        normal = comm.bcast(normal, root=0)
+    if case == "none":
+        rough = InterfaceLaw(normal=normal)
+    else:
+        c = FRICTION_CASES[case]
+        friction = OrthotropicSlipHardening(mu_macro=c["mu_macro"],
+                                            mu_initial_ratio=c["mu_initial_ratio"],
+                                            hardening=HARDENING, potential_axes=c["nu"])
+        rough = InterfaceLaw(normal=normal, tangential=TangentialStiffness(c["kt"]),
+                             friction=friction)
+    return rough.with_seating(seating_pressure), normal
+
+
+# ## Scene, spaces, conditions, problem
+@dataclass(frozen=True)
+class PunchScene:
+    """The quarter-punch mesh, its displacement space and boundary conditions.
+
+    Attributes:
+        scene: mesh, cell/facet tags and labels (punch, foundation, load, contact pair, ...).
+        V: vector Lagrange space of the displacement.
+        bcs: symmetry conditions u_x = 0 on x = 0, u_y = 0 on y = 0, and the clamped base.
+    """
+
+    scene: Scene
+    V: fem.FunctionSpace
+    bcs: list
+
+
+def quarter_punch(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2,
+                  load_half_width=2.5, cell_type="tetrahedron") -> PunchScene:
+    """Mesh the quarter punch and set its space and boundary conditions. Collective."""
+    check_scalar("mesh_size", mesh_size, lo=0.0, unit="mm")
+    check_scalar("contact_size", contact_size, lo=0.0, unit="mm")
+    check_scalar("load_half_width", load_half_width, lo=0.0, unit="mm")
+    if order not in (1, 2):
+        raise ValueError(f"order = {order!r} is invalid: it must be 1 or 2")
+    scene = flat_punch(mesh_size=mesh_size, contact_size=contact_size, order=order,
+                       load_half_width=load_half_width, cell_type=cell_type, comm=comm)
+    V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", order))
+    fdim = scene.mesh.topology.dim - 1
+
+    def dofs(name, comp=None):
+        facets = scene.facet_tags.find(scene.tag(name))
+        if comp is None:
+            return fem.locate_dofs_topological(V, fdim, facets)
+        return fem.locate_dofs_topological(V.sub(comp), fdim, facets)
+
+    zero = PETSc.ScalarType(0.0)
+    bcs = [fem.dirichletbc(zero, dofs("symmetry_x", 0), V.sub(0)),
+           fem.dirichletbc(zero, dofs("symmetry_y", 1), V.sub(1)),
+           fem.dirichletbc(np.zeros(3, dtype=PETSc.ScalarType), dofs("fixed"), V)]
+
+    return PunchScene(scene, V, bcs)
+
+
+@dataclass(frozen=True)
+class PunchModel:
+    """Everything :func:`build` sets up for the quarter punch (same objects on every rank).
+
+    Attributes:
+        scene: mesh, cell/facet tags and labels of punch and foundation.
+        V: vector Lagrange space of the displacement.
+        law: the interface law (seated: its ``h0`` carries the first increment's pressure).
+        normal: the tabulated normal law (None for the penalty stand-in).
+        interface: the contact interface (first surface = punch bottom).
+        problem: bulk elasticity + interface.
+        solver: the SNES solver (options prefix given to :func:`build`).
+        quarter_force: total force on the quarter model at load factor 1 [N].
+    """
+
+    scene: Scene
+    V: fem.FunctionSpace
+    law: InterfaceLawProtocol
+    normal: Optional[object]
+    interface: ContactInterface
+    problem: ContactProblem
+    solver: SNESSolver
+    quarter_force: float
+
+
+def build(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2, load_half_width=2.5,
+          law="rough", case="b", normal_law="elasto-plastic", steps=16, prefix="rc_",
+          dof_threshold=100_000, quadrature_degree=None, normal=None, seating_steps=None,
+          cell_type="tetrahedron", *, punch_scene=None, total_force=TOTAL_FORCE,
+          solver_defaults=None):
+    """Mesh, law, interface, problem and solver of the quarter punch. Collective.
+
+    ``punch_scene`` reuses a :class:`PunchScene` of :func:`quarter_punch` (mesh sizes, order
+    and cell type are then taken from it); ``total_force`` is the full punch's force at load
+    factor 1 [N] (the quarter carries a quarter); ``solver_defaults`` are extra SNES/KSP/PC
+    defaults (without prefix) that the command line can override.
+
+    ``normal`` passes a prebuilt NormalLaw (same on every rank); ``seating_steps`` (default
+    ``steps``) sets the seating pressure to the nominal pressure of 1/seating_steps of the load.
+
+    ``law`` is "rough", "penalty" or any object satisfying the interface-law contract
+    (``rough_contact.interface.contract.InterfaceLawProtocol``), used as given.
+
+    Returns:
+        :class:`PunchModel`.
+    """
+    if int(steps) != steps or steps < 1:
+        raise ValueError(f"steps = {steps!r} is invalid: it must be an integer >= 1")
+    if seating_steps is not None and (int(seating_steps) != seating_steps or seating_steps < 1):
+        raise ValueError(f"seating_steps = {seating_steps!r} is invalid: it must be an integer >= 1")
+    if punch_scene is None:
+        punch_scene = quarter_punch(comm, mesh_size, contact_size, order, load_half_width,
+                                    cell_type)
+    scene, V, bcs = punch_scene.scene, punch_scene.V, punch_scene.bcs
+    order = V.ufl_element().degree()
+
+    check_scalar("total_force", total_force, lo=0.0, unit="N")
+    quarter_force = total_force / 4.0
+    contact_area = scene.dimensions["half_width"] ** 2
+    # Seat the rough surfaces with the nominal pressure of the first increment.
+    p_seat = quarter_force / (seating_steps or steps) / contact_area
+    if isinstance(law, str):
+        interface_law, normal = make_law(comm, law, case, normal_law, seating_pressure=p_seat,
+                                         normal=normal)
+    else:
+        interface_law = law
+
+    first, second = scene.contact_pair
+    qdeg = quadrature_degree if quadrature_degree is not None else 2 * order
+    interface = ContactInterface(V, scene.facet_tags, first, second, law=interface_law,
+                                 grain_direction=(1.0, 0.0, 0.0), quadrature_degree=qdeg, bcs=bcs)
+    materials = {scene.tag("punch"): Material(E, NU), scene.tag("foundation"): Material(E, NU)}
+    loads = [SurfaceLoad(scene.tag("load"), force=[0.0, 0.0, -quarter_force])]
+    problem = ContactProblem(V, materials, bcs, loads, cell_tags=scene.cell_tags,
+                             facet_tags=scene.facet_tags, interface=interface,
+                             seating_tag=first, seating_stiffness=1e3,
+                             body_cells=[scene.cell_tags.find(scene.tag(b)) for b in scene.bodies])
+    solver = SNESSolver(problem, prefix=prefix, dof_threshold=dof_threshold,
+                        defaults=solver_defaults)
+    return PunchModel(scene=scene, V=V, law=interface_law, normal=normal, interface=interface,
+                      problem=problem, solver=solver, quarter_force=quarter_force)
+
+
+# ## Output helpers
+def point_data(interface):
+    """Interface fields at this rank's points, slips turned into global (x, y) components.
+
+    For the flat punch the first surface is the punch bottom: n = -z, x = grain = +x and
+    y = n x x = -y, so a local (s_x, s_y) is the global (s_x, -s_y).
+    """
+    pf = interface.point_fields()
+    flip = np.array([1.0, -1.0])
+    return interface.point_coordinates(), {
+        "pressure_MPa": pf.pressure,
+        "area_fraction": pf.area_fraction,
+        "gap_mm": pf.gap,
+        "slip_mm": pf.slip * flip,
+        "plastic_slip_mm": pf.plastic_slip * flip,
+        "dissipation_N_per_mm": pf.dissipation,
+        "contact": pf.contact.astype(float),
+        "slipping": pf.slipping.astype(float),
+    }
+
+
+def plot_slip_directions(comm, interface, path, title, n_grid=12):
+    """Quiver of the plastic slip directions at contact points (Figs 18-19). Collective."""
+    pts, fields = gather_points(comm, *point_data(interface))
+    if comm.rank != 0:
+        return
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from scipy.spatial import cKDTree
+
+    # Sample a regular n_grid x n_grid set of points over the patch (the paper plots nodes).
+    a = float(np.max(pts[:, 0]))
+    g = (np.arange(n_grid) + 0.5) * a / n_grid
+    gx, gy = np.meshgrid(g, g)
+    _, idx = cKDTree(pts[:, :2]).query(np.column_stack([gx.ravel(), gy.ravel()]))
+    idx = np.unique(idx)
+    sp = fields["plastic_slip_mm"][idx]
+    mag = np.linalg.norm(sp, axis=1)
+    unit = np.where(mag[:, None] > 0, sp / np.maximum(mag, 1e-300)[:, None], 0.0)
+    fig, ax = plt.subplots(figsize=(6, 5.4))
+    q = ax.quiver(pts[idx, 0], pts[idx, 1], unit[:, 0], unit[:, 1], mag * 1e3, cmap="viridis",
+                  pivot="tail", scale=n_grid * 1.3, scale_units="width")
+    fig.colorbar(q, ax=ax, label="|plastic slip| [um]")
+    ax.set_xlim(0, a * 1.05)
+    ax.set_ylim(0, a * 1.05)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (grain direction) [mm]")
+    ax.set_ylabel("y [mm]")
+    ax.set_title(title + "\n(plastic part of u_foundation - u_punch, local x/y turned to global)",
+                 fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+
+
+# ## The run
+def run(mesh_size=20.0, contact_size=2.0, order=2, load_half_width=2.5, steps=16,
+         unload=True, law="rough", case="b", normal_law="elasto-plastic", outdir="results/flat_punch",
+         prefix="rc_", dof_threshold=100_000, comm=MPI.COMM_WORLD, verbose=True, plot=True):
+    """Run the punch; return a dict of results (identical on every rank). Collective."""
+    t0 = MPI.Wtime()
+    m = build(comm, mesh_size, contact_size, order, load_half_width, law, case, normal_law,
+              steps, prefix, dof_threshold)
+    problem, solver, interface = m.problem, m.solver, m.interface
+    n_points = interface.n_points_global
+    PETSc.Sys.Print(f"Flat punch (quarter): {problem.num_dofs} DOFs, {n_points} interface points, "
+                    f"P{order}, law={law} ({normal_law}, friction case {case}), "
+                    f"h0 = {getattr(m.law, 'h0', float('nan')) * 1e3:.4f} um, "
+                    f"linear solver {solver.linear_solver}, {comm.size} rank(s)", comm=comm)
+
+    factors = load_unload_factors(steps, steps - 1 if unload else 0)
+    writer = ResultWriter(outdir, comm, u=problem.u,
+                          point_data=lambda: point_data(interface),
+                          extra_columns=("force_error_rel",))
+    history = []
+    peak = None
+    for inc in load_path(problem, solver, factors, verbose=verbose):
+        # Force balance: the normal interface force on the punch equals the applied load (its
+        # tangential resultant is carried by the symmetry planes of the quarter model).
+        err = abs(inc.contact_force[2] + inc.applied_force[2]) / abs(inc.applied_force[2])
+        writer.write(inc, extra={"force_error_rel": err})
+        history.append(inc)
+        if inc.load_factor == 1.0 and inc.target == 1.0:
+            peak = inc
+            if plot:
+                plot_slip_directions(comm, interface, os.path.join(outdir, "slip_directions_peak.png"),
+                                     f"plastic slip directions at 1000 N (case {case})")
+    if plot:
+        plot_slip_directions(comm, interface, os.path.join(outdir, "slip_directions.png"),
+                             f"plastic slip directions after unloading (case {case})")
+
+    # ## Check and comparison with the paper
+    D = interface.dissipation()
+    max_force_error = max(abs(i.contact_force[2] + i.applied_force[2]) / abs(i.applied_force[2])
+                          for i in history)
+    PETSc.Sys.Print(f"\nForce balance: max |Fz_contact + Fz_applied| / |Fz_applied| = "
+                    f"{max_force_error:.2e} over {len(history)} increments", comm=comm)
+    if case in FRICTION_CASES and law == "rough":
+        PETSc.Sys.Print(f"Total frictional dissipation D (quarter model, all contact points): "
+                        f"{D:.4g} N mm  [paper Table 5, case ({case}): "
+                        f"{TABLE5['21-node'][case]} (21-node), {TABLE5['28-node'][case]} (28-node)]",
+                        comm=comm)
+    else:
+        PETSc.Sys.Print(f"Total frictional dissipation D: {D:.4g} N mm", comm=comm)
+    PETSc.Sys.Print(f"Output in {outdir}/ (displacement.xdmf, interface.xdmf, history.csv, "
+                    f"slip_directions*.png); wall time {MPI.Wtime() - t0:.1f} s", comm=comm)
+    assert max_force_error < 1e-6, f"force balance violated: {max_force_error:.3e}"
+    solver.destroy()
+    return dict(dissipation=D, history=history, peak=peak, num_dofs=problem.num_dofs,
+                n_points=n_points, max_force_error=max_force_error)
+
+

@@ -1,0 +1,83 @@
+"""Every demo runs, at a small size, as a user would run it (a subprocess, as dolfinx's own
+``python/demo/test.py`` does): exit code 0 and the line that reports its check.
+
+The demos' numbers are verified by the library tests (tests/fem, tests/unit); these tests make
+sure the scripts themselves — argument parsing, PETSc options, output — keep working.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+DEMOS = ROOT / "demos"
+MPIRUN = shutil.which("mpirun")
+
+
+def run(args, tmp_path, ranks=1, timeout=600):
+    env = dict(os.environ, MPLBACKEND="Agg", OMPI_ALLOW_RUN_AS_ROOT="1",
+               OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OPENBLAS_NUM_THREADS="1")
+    cmd = [sys.executable] + [str(a) for a in args]
+    if ranks > 1:
+        cmd = [MPIRUN, "-n", str(ranks)] + cmd
+    proc = subprocess.run(cmd, cwd=tmp_path, env=env, capture_output=True, text=True,
+                          timeout=timeout)
+    assert proc.returncode == 0, f"{' '.join(cmd)} failed:\n{proc.stdout[-3000:]}\n{proc.stderr[-3000:]}"
+    return proc.stdout
+
+
+PUNCH_SMALL = ["--mesh-size", "20", "--contact-size", "5", "--order", "1", "--steps", "2",
+               "--normal-law", "elastic"]
+
+
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_demo_flat_punch(tmp_path, ranks):
+    if ranks > 1 and MPIRUN is None:
+        pytest.skip("mpirun not found")
+    out = run([DEMOS / "demo_flat_punch.py", *PUNCH_SMALL, "--outdir", tmp_path / "punch",
+               "-rc_snes_rtol", "1e-9"], tmp_path, ranks)
+    assert "Force balance: max |Fz_contact + Fz_applied|" in out
+    assert "Total frictional dissipation D" in out
+    assert (tmp_path / "punch" / "history.csv").exists()
+
+
+def test_demo_flat_punch_rejects_bad_options(tmp_path):
+    env = dict(os.environ, MPLBACKEND="Agg")
+    for args, words in ((["--steps", "0"], "steps = 0"), (["--mesh-size", "-1"], "mesh_size"),
+                        (["--stpes", "4"], "unrecognized arguments: --stpes")):
+        proc = subprocess.run([sys.executable, str(DEMOS / "demo_flat_punch.py"), *args],
+                              cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300)
+        assert proc.returncode != 0
+        assert words in proc.stderr, proc.stderr[-2000:]
+
+
+def test_demo_beam_rigid_base(tmp_path):
+    out = run([DEMOS / "demo_beam_rigid_base.py", "--cases", "1", "--mesh-size", "80",
+               "--contact-size", "20", "--order", "1", "--steps", "2", "--no-xdmf",
+               "--outdir", tmp_path / "beam"], tmp_path)
+    assert "| 1 | 0.625 | elastic |" in out
+    assert (tmp_path / "beam" / "table4.md").exists()
+
+
+def test_study_flat_punch_cases(tmp_path):
+    out = run([DEMOS / "study_flat_punch_cases.py", "--cases", "a", "--mesh-size", "25",
+               "--contact-size", "5", "--steps", "2", "--normal-law", "elastic",
+               "--outdir", tmp_path / "cases", "--figdir", tmp_path / "fig"], tmp_path)
+    assert "case (a): D_cum peak" in out
+    assert (tmp_path / "fig" / "punch_case_a.png").exists()
+
+
+def test_demo_micro_model(tmp_path):
+    out = run([DEMOS / "demo_micro_model.py", "--quick", "--out", tmp_path / "micro"], tmp_path)
+    assert "Table 1" in out
+
+
+def test_demo_friction_point(tmp_path):
+    out = run([DEMOS / "demo_friction_point.py", "--out", tmp_path / "fp"], tmp_path)
+    assert out.strip()
