@@ -225,6 +225,7 @@ class ContactInterface:
 
         # ---- first surface: quadrature, geometry, basis -----------------------------------
         facets1 = _owned_tagged_facets(facet_tags, first_tag, n_owned_facets, comm)
+        self._facets1 = facets1
         geo1 = _FacetGeometry(V, facets1)
         n_f = facets1.size
         cell = _basix_cell(msh)
@@ -622,6 +623,16 @@ class ContactInterface:
             return np.zeros((self.n_points, 2))
         return np.asarray(ps)[:, :2]
 
+    @property
+    def facets(self) -> np.ndarray:
+        """(n_facets,) local indices of this rank's owned first-surface facets, in point order:
+        point i lies on facet ``facets[i // n_qp]`` (read-only)."""
+        return _read_only(self._facets1)
+
+    def local_frames(self) -> np.ndarray:
+        """(n_pts, 3, 3) local axes per point: rows n, x, y in global components (read-only)."""
+        return _read_only(self._R)
+
     def point_coordinates(self) -> np.ndarray:
         """(n_pts, 3) reference coordinates of this rank's interface points [mm]."""
         return self._x
@@ -652,6 +663,12 @@ _CELLS = {
     dolfinx.mesh.CellType.tetrahedron: (basix.CellType.tetrahedron, basix.CellType.triangle),
     dolfinx.mesh.CellType.hexahedron: (basix.CellType.hexahedron, basix.CellType.quadrilateral),
 }
+
+
+def _read_only(a: np.ndarray) -> np.ndarray:
+    view = a.view()
+    view.flags.writeable = False
+    return view
 
 
 def _basix_cell(msh) -> basix.CellType:
