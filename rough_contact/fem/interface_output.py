@@ -522,18 +522,19 @@ class InterfaceWriter:
             fid = np.repeat(np.arange(x.shape[0]), n_qp)
             x = x.reshape(-1, 3)
             within = np.lexsort((x[:, 2], x[:, 1], x[:, 0], fid))
-            point_order = (surface.order[:, None] * n_qp + np.arange(n_qp)).ravel()[within]
+            self._point_order = (surface.order[:, None] * n_qp + np.arange(n_qp)).ravel()[within]
             import h5py
 
             with h5py.File(self.h5_path, "w") as h5:
                 h5["Mesh/geometry"] = surface.points
                 h5["Mesh/topology"] = surface.cells
                 if self.points:
-                    h5["Points/geometry"] = xq["x"][point_order]
+                    h5["Points/geometry"] = xq["x"][self._point_order]
             self._write_xml()
-            return point_order
 
-        self._point_order = _collective(self.comm, create)
+        self._point_order = None  # rank 0 only, like every gathered array
+        self._specs: dict = {}
+        _collective(self.comm, create)
 
     # ------------------------------------------------------------------ XML
     def _grid(self, k: int, mesh_items: list, items: list, center: str) -> list:
