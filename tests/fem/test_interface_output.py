@@ -23,6 +23,7 @@ import pytest
 from mpi4py import MPI
 from petsc4py import PETSc
 
+import dolfinx.mesh
 from dolfinx import fem
 
 from meshes.blocks import block_on_plane
@@ -298,12 +299,14 @@ def test_files_do_not_depend_on_rank_count(punch):
     comm.barrier()
 
 
-@pytest.mark.parametrize("cell_type,order,grain", [("tetrahedron", 2, (1.0, 0.0, 0.0)),
-                                                   ("hexahedron", 1, (1.0, 2.0, 0.0))])
-def test_analytic_penalty_state_global_vectors(cell_type, order, grain):
+@pytest.mark.parametrize("cell_type,order,grain,empty_ranks", [
+    ("tetrahedron", 2, (1.0, 0.0, 0.0), False), ("hexahedron", 1, (1.0, 2.0, 0.0), False),
+    ("tetrahedron", 1, (0.0, 1.0, 0.0), True)])
+def test_analytic_penalty_state_global_vectors(cell_type, order, grain, empty_ranks):
     """Block on a rigid plane, uniform displacement u = (a, b, -d): with a linear penalty the
     global slip is -(a, b, 0), the traction on the block (-kT a, -kT b, kN d), whatever the
-    local axes (grain direction); quadrilateral facets for hexahedra, curved P2 tetrahedra."""
+    local axes (grain direction); quadrilateral facets for hexahedra, P2 tetrahedra; with
+    ``empty_ranks`` only rank 0's facets are tagged, so the other ranks own no contact facet."""
     comm = MPI.COMM_WORLD
     lx, ly = 1.0, 2.0
     scene = block_on_plane(lx=lx, ly=ly, h=0.5, mesh_size=0.5, order=order, cell_type=cell_type,
@@ -312,7 +315,11 @@ def test_analytic_penalty_state_global_vectors(cell_type, order, grain):
     kn, kt = 1.0e5, 3.0e4
     a, b, d = 2e-4, -1e-4, 5e-4
     contact = scene.tag("contact")
-    ci = ContactInterface(V, scene.facet_tags, contact, None, law=LinearPenalty(kn, kt),
+    tags = scene.facet_tags
+    if empty_ranks and comm.rank > 0:
+        tags = dolfinx.mesh.meshtags(scene.mesh, 2, tags.indices,
+                                     np.where(tags.values == contact, 99, tags.values))
+    ci = ContactInterface(V, tags, contact, None, law=LinearPenalty(kn, kt),
                           rigid_plane=((0.0, 0.0, 0.0), (0.0, 0.0, 1.0)), grain_direction=grain)
     u = fem.Function(V)
     u.interpolate(lambda x: np.vstack([np.full(x.shape[1], a), np.full(x.shape[1], b),
@@ -334,7 +341,11 @@ def test_analytic_penalty_state_global_vectors(cell_type, order, grain):
             normal = 0.5 * np.cross(x[:, 2] - x[:, 0], x[:, 3] - x[:, 1])
         else:
             normal = 0.5 * np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0])
-        assert np.isclose(np.linalg.norm(normal, axis=1).sum(), lx * ly, rtol=1e-12)
+        assert np.isclose(np.linalg.norm(normal, axis=1).sum(),
+                          ci.nominal_area() if empty_ranks else lx * ly, rtol=1e-12)
+        assert len(cells) == comm.allreduce(ci.n_facets, op=MPI.SUM)
+        if empty_ranks and comm.size > 1:
+            assert ci.n_facets == 0 or comm.rank == 0
         assert np.all(normal[:, 2] < 0)  # n points from the block into the plane
         for name, n_rows in (("interface.xdmf", len(cells)),
                              ("interface_points.xdmf", ci.n_points_global)):
