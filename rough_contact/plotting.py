@@ -143,7 +143,7 @@ def plot_facet_field(points, cells, values, *, label: str = "", title: str = "",
         label: colour-bar label (name and unit).
         title: axes title.
         cmap: matplotlib colour map (ParaView's default "Cool to Warm" is ``"coolwarm"``).
-        clim: (min, max) of the colour scale; default the data range.
+        clim: (min, max) of the colour scale; default the data range (the step's range).
         edges: draw the facet edges.
         axes: projection plane (module docstring).
         point_size: marker size for point values.
@@ -162,7 +162,10 @@ def plot_facet_field(points, cells, values, *, label: str = "", title: str = "",
 
     fig, ax = _new_figure(ax, figsize)
     p2, names = _plane(p, axes)
-    lo, hi = clim if clim is not None else (float(v.min(initial=0.0)), float(v.max(initial=1.0)))
+    if clim is not None:
+        lo, hi = (float(c_) for c_ in clim)
+    else:  # the data range, as ParaView's "Rescale to data range"
+        lo, hi = (float(v.min()), float(v.max())) if v.size else (0.0, 1.0)
     if hi <= lo:  # a uniform field: a symmetric band around it keeps the colour bar readable
         pad = abs(lo) * 1e-6 or 1.0
         lo, hi = lo - pad, hi + pad

@@ -690,6 +690,10 @@ class InterfaceResults:
 
 
 def _split_item(item: ET.Element, folder: str) -> tuple[str, str]:
+    if item.get("Format") != "HDF" or ":" not in item.text:
+        raise ValueError(f"data item {item.text.strip()!r} (format {item.get('Format')!r}) is "
+                         "not HDF5 data of InterfaceWriter: the file was written by another "
+                         "writer (e.g. the binary point cloud of ResultWriter)")
     file_name, path = item.text.strip().split(":", 1)
     return os.path.join(folder, file_name), path
 
