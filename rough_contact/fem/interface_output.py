@@ -63,7 +63,7 @@ from .contact import PointFields
 __all__ = [
     "STATUS_OPEN", "STATUS_STICK", "STATUS_SLIP", "STATUS_NAMES", "InterfaceOutputSource",
     "PointOutput", "FacetOutput", "SurfaceMesh", "InterfaceWriter", "InterfaceResults",
-    "OutputExistsError", "RUN_OUTPUT_PATTERNS", "facet_average", "facet_status",
+    "OutputExistsError", "RUN_OUTPUT_PATTERNS", "FACET_FIELD_NAMES", "POINT_FIELD_NAMES", "facet_average", "facet_status",
     "point_output", "facet_output", "facet_vertex_coordinates", "gather_surface",
     "prepare_output_dir", "pseudo_time", "read_interface_results",
 ]
@@ -267,9 +267,9 @@ def facet_output(interface: InterfaceOutputSource,
                  points: Optional[PointOutput] = None) -> FacetOutput:
     """This rank's facet fields (quadrature averages of :func:`point_output`)."""
     po = point_output(interface) if points is None else points
-    pf = interface.point_fields()
     n_qp, w = interface.n_qp, po.weight
-    status, contact_fraction, slip_fraction = facet_status(pf.contact, pf.slipping, w, n_qp)
+    status, contact_fraction, slip_fraction = facet_status(po.status != STATUS_OPEN,
+                                                           po.status == STATUS_SLIP, w, n_qp)
     avg = {attr: facet_average(getattr(po, attr), w, n_qp)
            for attr, _ in _FIELDS if attr != "status"}
     return FacetOutput(status=status, contact_fraction=contact_fraction,
