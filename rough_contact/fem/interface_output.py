@@ -18,7 +18,8 @@ first contact surface:
 * **status** per facet: 0 = open, 1 = stick, 2 = slip, the state that covers the largest part
   of the facet's area (sum of quadrature weights of its points in that state); a point is open
   where p = 0 (not in contact), slipping where the friction limit is active, else sticking.
-  Ties (parts equal to 1e-9 of the facet area) go to the more active state (slip, then stick).
+  Ties (parts equal to within 1e-9 of the facet area) go to the more active state (slip, then
+  stick).
   ``contact_fraction`` and ``slip_fraction`` give the parts of each facet in contact and
   slipping [-], so the status never hides a partly slipping facet.
 
