@@ -12,7 +12,7 @@ here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 cd "$here"
 
 DEB_PACKAGES=(python3-dolfinx python3-gmsh python3-scipy python3-pytest python3-matplotlib
-              python3-venv python3-wheel libopenblas0-pthread openmpi-bin)
+              python3-h5py python3-venv python3-wheel libopenblas0-pthread openmpi-bin)
 VENV="$here/.venv"
 TEST_EXTRAS=""
 PY="$VENV/bin/python"

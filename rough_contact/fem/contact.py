@@ -237,6 +237,7 @@ class ContactInterface:
         rule = _FacetRule.create(V.mesh, degree)
         geo1 = _FacetGeometry(V, _owned_tagged_facets(facet_tags, first_tag, n_owned_facets,
                                                       self.comm))
+        self._facets1 = geo1.facets
         xq, normal, N1 = self._first_surface(geo1, rule)
         R = self._local_axes(xq, normal, grain, rigid_plane)
         if second_tag is None:
@@ -431,7 +432,7 @@ class ContactInterface:
         raise_on_all_ranks(self.comm, error)
         return StatePair(state)
 
-    def set_dirichlet_dofs(self, global_dofs: np.ndarray | None = None, bcs: Sequence[Any] = ()):
+    def set_dirichlet_dofs(self, global_dofs: np.ndarray | None = None, bcs: Sequence[dolfinx.fem.DirichletBCMetaClass] = ()):
         """Mark DOFs the interface must not assemble into (collective).
 
         Args:
@@ -692,6 +693,16 @@ class ContactInterface:
         """Same as :meth:`summary` (the name older callers use)."""
         return self.summary()
 
+    @property
+    def facets(self) -> np.ndarray:
+        """(n_facets,) local indices of this rank's owned first-surface facets, in point order:
+        point i lies on facet ``facets[i // n_qp]`` (read-only)."""
+        return _read_only(self._facets1)
+
+    def local_frames(self) -> np.ndarray:
+        """(n_pts, 3, 3) local axes per point: rows n, x, y in global components (read-only)."""
+        return _read_only(self._R)
+
     def point_coordinates(self) -> np.ndarray:
         """(n_pts, 3) reference coordinates of this rank's interface points [mm]."""
         return self._x
@@ -820,6 +831,12 @@ _CELLS = {
     dolfinx.mesh.CellType.tetrahedron: (basix.CellType.tetrahedron, basix.CellType.triangle),
     dolfinx.mesh.CellType.hexahedron: (basix.CellType.hexahedron, basix.CellType.quadrilateral),
 }
+
+
+def _read_only(a: np.ndarray) -> np.ndarray:
+    view = a.view()
+    view.flags.writeable = False
+    return view
 
 
 def _basix_cell(msh) -> basix.CellType:

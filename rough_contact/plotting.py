@@ -1,0 +1,424 @@
+"""Plots of interface results and load paths, from plain arrays (matplotlib, Agg backend).
+
+Units are the caller's; the default labels assume the project's mm, N, MPa (slips are shown
+in um). Every function builds a ``matplotlib.figure.Figure`` on the Agg canvas (no pyplot, no
+window, no global state), draws into ``ax`` if one is given, saves a PNG when ``path`` is
+given, and returns the figure. matplotlib is imported only when a plot is made, so importing
+this module needs numpy alone.
+
+Interface plots take either facets (``points`` (n_v, 3) and ``cells`` (n_c, 3|4) vertex
+indices, values per cell: the surface of ``interface.xdmf``) or points (``cells=None``, values
+per point: the quadrature-point cloud). 3D coordinates are projected on a coordinate plane:
+``axes="xy"``, ``"xz"``, ``"yz"``, or ``"auto"`` (the plane across the smallest extent, i.e.
+the plane of a flat interface).
+
+* :func:`plot_facet_field` / :func:`plot_pressure_map`: flat-shaded facets with a colour bar
+  and the mesh edges (what ParaView shows with "Surface With Edges").
+* :func:`plot_status_map`: open / stick / slip with their share of the area.
+* :func:`plot_slip_quiver`: arrows of a tangential vector field (slip, plastic slip, shear).
+* :func:`plot_load_displacement`: one or more load-displacement curves.
+* :func:`plot_hysteresis`: force-displacement loops with the energy of every cycle,
+  :func:`loop_energies` (the closed-path integral of F du), cycles split by
+  :func:`split_cycles`.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Mapping, Optional, Sequence
+
+import numpy as np
+
+__all__ = ["STATUS_COLORS", "plot_facet_field", "plot_pressure_map", "plot_status_map",
+           "plot_slip_quiver", "plot_load_displacement", "plot_hysteresis", "loop_energies",
+           "split_cycles"]
+
+STATUS_LABELS = ("open", "stick", "slip")
+STATUS_COLORS = ("#d9d9d9", "#3b6fb6", "#d6452b")  # grey, blue, red
+_AXES = {"xy": (0, 1), "xz": (0, 2), "yz": (1, 2)}
+
+
+# --------------------------------------------------------------------------------------------
+# helpers
+# --------------------------------------------------------------------------------------------
+def _new_figure(ax, figsize):
+    if ax is not None:
+        return ax.figure, ax
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=figsize)
+    FigureCanvasAgg(fig)
+    return fig, fig.add_subplot()
+
+
+def _finish(fig, path: Optional[str], dpi: int):
+    if path is not None:
+        fig.tight_layout()
+        fig.savefig(path, dpi=dpi)
+    return fig
+
+
+def _points(points) -> np.ndarray:
+    p = np.asarray(points, dtype=float)
+    if p.ndim != 2 or p.shape[1] not in (2, 3) or not np.all(np.isfinite(p)):
+        raise ValueError(f"points of shape {p.shape} must be finite (n, 2) or (n, 3) [mm]")
+    return p
+
+
+def _plane(points: np.ndarray, axes: str) -> tuple[np.ndarray, tuple[str, str]]:
+    """2D coordinates of the points on the chosen coordinate plane and the axis names."""
+    if points.shape[1] == 2:
+        return points, ("x", "y")
+    if axes == "auto":
+        drop = int(np.argmin(np.ptp(points, axis=0))) if len(points) else 2
+        pair = tuple(i for i in range(3) if i != drop)
+    elif axes in _AXES:
+        pair = _AXES[axes]
+    else:
+        raise ValueError(f"axes = {axes!r} is invalid; valid: 'auto', 'xy', 'xz', 'yz'")
+    return points[:, pair], tuple("xyz"[i] for i in pair)
+
+
+def _cells(cells, n_points: int) -> np.ndarray:
+    c = np.asarray(cells)
+    if c.ndim != 2 or c.shape[1] not in (3, 4) or not np.issubdtype(c.dtype, np.integer):
+        raise ValueError(f"cells of shape {c.shape} ({c.dtype}) must be integer (n, 3) or (n, 4)")
+    if c.size and (c.min() < 0 or c.max() >= n_points):
+        raise ValueError(f"cell vertex indices span [{c.min()}, {c.max()}], valid [0, "
+                         f"{n_points - 1}]")
+    return c
+
+
+def _values(values, n: int, what: str, ncomp: Optional[int] = None) -> np.ndarray:
+    """Finite float array of n rows: (n,) scalars, (n, ncomp), or (n, 2|3) with ncomp=-1."""
+    v = np.asarray(values, dtype=float)
+    if ncomp == -1:
+        ok, expected = v.ndim == 2 and v.shape[0] == n and v.shape[1] in (2, 3), f"({n}, 2|3)"
+    else:
+        expected = (n,) if ncomp is None else (n, ncomp)
+        ok = v.shape == expected
+    if not ok:
+        raise ValueError(f"{what} of shape {v.shape} must be of shape {expected}")
+    if not np.all(np.isfinite(v)):
+        raise ValueError(f"{what} holds {int(np.sum(~np.isfinite(v)))} non-finite values")
+    return v
+
+
+def _draw_map(ax, p2, cells, values, *, cmap, norm, edges, point_size):
+    """Flat-shaded facets (or points) coloured by values; returns the mappable."""
+    if cells is None:
+        return ax.scatter(p2[:, 0], p2[:, 1], c=values, cmap=cmap, norm=norm, s=point_size,
+                          edgecolors="none")
+    from matplotlib.collections import PolyCollection
+
+    coll = PolyCollection(p2[cells], array=values, cmap=cmap, norm=norm,
+                          edgecolors="#202020" if edges else "face",
+                          linewidths=0.4 if edges else 0.0)
+    ax.add_collection(coll)
+    ax.autoscale_view()
+    return coll
+
+
+def _frame(ax, names, title, unit="mm"):
+    ax.set_aspect("equal")
+    ax.set_xlabel(f"{names[0]} [{unit}]")
+    ax.set_ylabel(f"{names[1]} [{unit}]")
+    if title:
+        ax.set_title(title, fontsize=10)
+
+
+# --------------------------------------------------------------------------------------------
+# interface maps
+# --------------------------------------------------------------------------------------------
+def plot_facet_field(points, cells, values, *, label: str = "", title: str = "",
+                     cmap: str = "coolwarm", clim: Optional[tuple] = None, edges: bool = True,
+                     axes: str = "auto", point_size: float = 12.0, ax: Any = None,
+                     path: Optional[str] = None, figsize=(6.0, 5.0), dpi: int = 150):
+    """A scalar field on the interface: flat-shaded facets with mesh edges and a colour bar.
+
+    Args:
+        points: (n_v, 3) vertex coordinates [mm] (or (n, 3) point coordinates).
+        cells: (n_c, 3|4) facet vertex indices, or None for values at ``points``.
+        values: (n_c,) per facet, or (n,) per point with ``cells=None``.
+        label: colour-bar label (name and unit).
+        title: axes title.
+        cmap: matplotlib colour map (ParaView's default "Cool to Warm" is ``"coolwarm"``).
+        clim: (min, max) of the colour scale; default the data range (the step's range).
+        edges: draw the facet edges.
+        axes: projection plane (module docstring).
+        point_size: marker size for point values.
+        ax: draw into these axes instead of a new figure.
+        path: save a PNG there.
+        figsize, dpi: of a new figure / the PNG.
+
+    Returns:
+        The figure.
+    """
+    p = _points(points)
+    c = None if cells is None else _cells(cells, len(p))
+    v = _values(values, len(p) if c is None else len(c),
+                "values (one per point)" if c is None else "values (one per cell)")
+    from matplotlib.colors import Normalize
+
+    fig, ax = _new_figure(ax, figsize)
+    p2, names = _plane(p, axes)
+    if clim is not None:
+        lo, hi = (float(c_) for c_ in clim)
+    else:  # the data range, as ParaView's "Rescale to data range"
+        lo, hi = (float(v.min()), float(v.max())) if v.size else (0.0, 1.0)
+    if hi <= lo:  # a uniform field: a symmetric band around it keeps the colour bar readable
+        pad = abs(lo) * 1e-6 or 1.0
+        lo, hi = lo - pad, hi + pad
+    mappable = _draw_map(ax, p2, c, v, cmap=cmap, norm=Normalize(lo, hi), edges=edges,
+                         point_size=point_size)
+    fig.colorbar(mappable, ax=ax, label=label)
+    _frame(ax, names, title)
+    return _finish(fig, path, dpi)
+
+
+def plot_pressure_map(points, cells, pressure, *, label: str = "contact pressure p [MPa]",
+                      **kwargs):
+    """Contact pressure on the interface (see :func:`plot_facet_field` for the arguments)."""
+    return plot_facet_field(points, cells, pressure, label=label, **kwargs)
+
+
+def plot_status_map(points, cells, status, *, weights=None, title: str = "",
+                    axes: str = "auto", edges: bool = True, point_size: float = 12.0,
+                    ax: Any = None, path: Optional[str] = None, figsize=(6.0, 5.0),
+                    dpi: int = 150):
+    """Open / stick / slip map with the share of each state in the legend.
+
+    Args:
+        points, cells, axes, edges, point_size, ax, path, figsize, dpi: as
+            :func:`plot_facet_field`.
+        status: (n_c,) or (n,) integers 0 open, 1 stick, 2 slip.
+        weights: (n_c,) or (n,) areas for the shares [mm^2]; default the facet areas
+            (facets) or equal weights (points).
+        title: axes title.
+
+    Returns:
+        The figure.
+    """
+    p = _points(points)
+    c = None if cells is None else _cells(cells, len(p))
+    n = len(p) if c is None else len(c)
+    s = np.asarray(status)
+    if s.shape != (n,) or (s.size and not np.isin(s, (0, 1, 2)).all()):
+        raise ValueError(f"status of shape {s.shape} must be ({n},) with values 0 (open), "
+                         f"1 (stick), 2 (slip); found {np.unique(s)[:6].tolist()}")
+    if weights is None:
+        if c is None:
+            w = np.ones(n)
+        else:  # facet areas from the (flat) facet polygons: fan of triangles from vertex 0
+            x = p[c] if p.shape[1] == 3 else np.pad(p, ((0, 0), (0, 1)))[c]
+            w = sum(0.5 * np.linalg.norm(np.cross(x[:, k] - x[:, 0], x[:, k + 1] - x[:, 0]),
+                                         axis=1) for k in range(1, c.shape[1] - 1))
+    else:
+        w = _values(weights, n, "weights")
+    from matplotlib.colors import BoundaryNorm, ListedColormap
+    from matplotlib.patches import Patch
+
+    fig, ax = _new_figure(ax, figsize)
+    p2, names = _plane(p, axes)
+    cmap = ListedColormap(STATUS_COLORS)
+    _draw_map(ax, p2, c, s.astype(float), cmap=cmap, norm=BoundaryNorm([-0.5, 0.5, 1.5, 2.5], 3),
+              edges=edges, point_size=point_size)
+    total = float(np.sum(w)) or 1.0
+    handles = [Patch(facecolor=STATUS_COLORS[k],
+                     label=f"{STATUS_LABELS[k]} {100.0 * np.sum(w[s == k]) / total:.0f} %")
+               for k in range(3)]
+    ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False,
+              title="area")
+    _frame(ax, names, title)
+    return _finish(fig, path, dpi)
+
+
+def plot_slip_quiver(points, vectors, *, cells=None, max_arrows: int = 400,
+                     normalize: bool = True, scale: float = 1e3, label: str = "|slip| [um]",
+                     title: str = "", axes: str = "auto", cmap: str = "viridis",
+                     outline: bool = True, ax: Any = None, path: Optional[str] = None,
+                     figsize=(6.0, 5.0), dpi: int = 150):
+    """Arrows of a tangential vector field (slip, plastic slip, shear traction).
+
+    Args:
+        points: (n_v, 3) vertices with ``cells``, else (n, 3) arrow positions [mm].
+        vectors: (n_c, 3) per facet (arrows at the facet centroids) or (n, 3) per point, in
+            global components [mm]; only the components in the projection plane are drawn.
+        cells: (n_c, 3|4) facet vertex indices, or None.
+        max_arrows: at most about this many arrows (one per cell of a regular grid over the
+            plot, so they stay readable on fine meshes).
+        normalize: draw unit arrows (directions, as the paper's Figs 18-19) coloured by the
+            magnitude; False draws arrows proportional to the vectors.
+        scale: factor from the vectors' unit to the colour-bar unit (1e3: mm to um).
+        label: colour-bar label.
+        title, axes, cmap, ax, path, figsize, dpi: as :func:`plot_facet_field`.
+        outline: draw the facet edges in light grey under the arrows.
+
+    Returns:
+        The figure.
+    """
+    p = _points(points)
+    c = None if cells is None else _cells(cells, len(p))
+    n = len(p) if c is None else len(c)
+    vec = _values(vectors, n, "vectors", ncomp=-1)
+    if int(max_arrows) < 1:
+        raise ValueError(f"max_arrows = {max_arrows!r} must be >= 1")
+    if vec.shape[1] == 2:
+        vec = np.column_stack([vec, np.zeros(n)])
+    at = p if c is None else p[c].mean(axis=1)
+    if at.shape[1] == 2:
+        at = np.column_stack([at, np.zeros(n)])
+    fig, ax = _new_figure(ax, figsize)
+    p3 = p if p.shape[1] == 3 else np.column_stack([p, np.zeros(len(p))])
+    p2, names = _plane(p3, axes)
+    pair = [("xyz".index(names[0])), ("xyz".index(names[1]))]
+    xy, uv = at[:, pair], vec[:, pair]
+    # thin out: one arrow per cell of a regular grid covering the plot
+    if n > max_arrows:
+        m = int(np.ceil(np.sqrt(max_arrows)))
+        lo, span = xy.min(axis=0), np.maximum(np.ptp(xy, axis=0), 1e-300)
+        ij = np.minimum((m * (xy - lo) / span).astype(int), m - 1)
+        _, keep = np.unique(ij[:, 0] * m + ij[:, 1], return_index=True)
+        xy, uv, vec = xy[keep], uv[keep], vec[keep]
+    mag = np.linalg.norm(vec, axis=1) * scale
+    if c is not None and outline:
+        from matplotlib.collections import PolyCollection
+
+        ax.add_collection(PolyCollection(p2[c], facecolors="none", edgecolors="#c8c8c8",
+                                         linewidths=0.4))
+    if normalize:
+        length = np.linalg.norm(uv, axis=1)
+        uv = np.where(length[:, None] > 0, uv / np.where(length > 0, length, 1.0)[:, None], 0.0)
+        span = float(np.max(np.ptp(p2, axis=0))) if len(p2) else 1.0
+        q = ax.quiver(xy[:, 0], xy[:, 1], uv[:, 0], uv[:, 1], mag, cmap=cmap, pivot="tail",
+                      angles="xy", scale_units="xy",
+                      scale=1.0 / (0.8 * span / np.sqrt(max(len(xy), 1))))
+    else:
+        q = ax.quiver(xy[:, 0], xy[:, 1], uv[:, 0], uv[:, 1], mag, cmap=cmap, pivot="tail",
+                      angles="xy")
+    fig.colorbar(q, ax=ax, label=label)
+    ax.autoscale_view()
+    _frame(ax, names, title)
+    return _finish(fig, path, dpi)
+
+
+# --------------------------------------------------------------------------------------------
+# load paths
+# --------------------------------------------------------------------------------------------
+def plot_load_displacement(curves: Mapping[str, tuple], *, xlabel: str = "displacement [mm]",
+                           ylabel: str = "force [N]", title: str = "", markers: bool = True,
+                           ax: Any = None, path: Optional[str] = None, figsize=(6.0, 4.5),
+                           dpi: int = 150):
+    """Load-displacement curves.
+
+    Args:
+        curves: {label: (displacement (n,), force (n,))}, drawn in order.
+        xlabel, ylabel, title: axis labels (with units) and title.
+        markers: mark the increments.
+        ax, path, figsize, dpi: as :func:`plot_facet_field`.
+
+    Returns:
+        The figure.
+    """
+    if not curves:
+        raise ValueError("curves is empty: give at least one {label: (displacement, force)}")
+    fig, ax = _new_figure(ax, figsize)
+    for name, (u, f) in curves.items():
+        u = np.asarray(u, dtype=float)
+        f = _values(f, len(u), f"force of curve {name!r}")
+        ax.plot(u, f, marker="o" if markers else None, ms=3, lw=1.2, label=name)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.grid(True, lw=0.3)
+    if len(curves) > 1 or next(iter(curves)):
+        ax.legend(frameon=False)
+    if title:
+        ax.set_title(title, fontsize=10)
+    return _finish(fig, path, dpi)
+
+
+def split_cycles(displacement: Sequence[float]) -> np.ndarray:
+    """Cycle boundaries of a cyclic path: its start, every local minimum of the displacement
+    (where it turns from decreasing to increasing), and its end.
+
+    Args:
+        displacement: (n,) displacement along the path.
+
+    Returns:
+        (n_cycles + 1,) increasing indices; cycle k spans ``[b[k], b[k + 1]]``.
+    """
+    u = np.asarray(displacement, dtype=float)
+    if u.ndim != 1 or len(u) < 2:
+        raise ValueError(f"displacement of shape {u.shape} must be 1D with >= 2 entries")
+    du = np.diff(u)
+    nonzero = np.flatnonzero(du)
+    if nonzero.size == 0:
+        return np.array([0, len(u) - 1])
+    sign = np.sign(du[nonzero])
+    # a turn from decreasing to increasing between two consecutive nonzero steps: the minimum
+    # is the point after the last decreasing step
+    minima = nonzero[np.flatnonzero((sign[:-1] < 0) & (sign[1:] > 0))] + 1
+    return np.unique(np.r_[0, minima, len(u) - 1])
+
+
+def loop_energies(displacement, force, boundaries) -> np.ndarray:
+    """Work of the force on each cycle, the path integral of F du (trapezoidal rule).
+
+    On a closed loop this is the area enclosed, the energy dissipated per cycle when F is the
+    force applied to the body and u its work-conjugate displacement (elastic energy is
+    returned over a closed cycle). The trapezoidal rule is exact for a path that is linear
+    between the recorded increments.
+
+    Args:
+        displacement: (n,) [mm].
+        force: (n,) [N].
+        boundaries: increasing indices, cycle k spans ``[b[k], b[k + 1]]``.
+
+    Returns:
+        (len(boundaries) - 1,) energies [N mm].
+    """
+    u = np.asarray(displacement, dtype=float)
+    f = _values(force, len(u), "force")
+    b = np.asarray(boundaries)
+    if (b.ndim != 1 or len(b) < 2 or not np.issubdtype(b.dtype, np.integer)
+            or np.any(np.diff(b) <= 0) or b[0] < 0 or b[-1] >= len(u)):
+        raise ValueError(f"boundaries {b.tolist()} must be increasing indices in [0, {len(u) - 1}]")
+    work = np.r_[0.0, np.cumsum(0.5 * (f[1:] + f[:-1]) * np.diff(u))]
+    return work[b[1:]] - work[b[:-1]]
+
+
+def plot_hysteresis(displacement, force, *, boundaries=None, energy_unit: str = "N mm",
+                    xlabel: str = "displacement [mm]", ylabel: str = "force [N]",
+                    title: str = "", ax: Any = None, path: Optional[str] = None,
+                    figsize=(6.0, 4.5), dpi: int = 150):
+    """Force-displacement hysteresis loops, one colour per cycle, the energy of each cycle
+    (:func:`loop_energies`) in the legend.
+
+    Args:
+        displacement: (n,) [mm].
+        force: (n,) [N].
+        boundaries: cycle boundaries (indices); default :func:`split_cycles`.
+        energy_unit: unit of F du for the legend.
+        xlabel, ylabel, title, ax, path, figsize, dpi: as :func:`plot_load_displacement`.
+
+    Returns:
+        The figure.
+    """
+    u = np.asarray(displacement, dtype=float)
+    f = _values(force, len(u), "force")
+    b = split_cycles(u) if boundaries is None else np.asarray(boundaries)
+    energies = loop_energies(u, f, b)
+    fig, ax = _new_figure(ax, figsize)
+    for k, e in enumerate(energies):
+        seg = slice(b[k], b[k + 1] + 1)
+        ax.plot(u[seg], f[seg], marker="o", ms=2.5, lw=1.2,
+                label=f"cycle {k + 1}: $\\oint F\\,du$ = {e:.4g} {energy_unit}")
+    ax.axhline(0.0, color="0.6", lw=0.5)
+    ax.axvline(0.0, color="0.6", lw=0.5)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.grid(True, lw=0.3)
+    ax.legend(frameon=False, fontsize=8)
+    if title:
+        ax.set_title(title, fontsize=10)
+    return _finish(fig, path, dpi)
