@@ -395,7 +395,7 @@ def test_jacobian_finite_difference_rough_law(degree, regime):
     assert fd_check(ci, V, x, 1e-8, np.random.default_rng(5)) < 1e-6
 
 
-# ---- scenes from meshes/ (gmsh): P2 geometry and hexahedra ---------------------------------
+# ---- scenes from rough_contact/scenes/meshes (gmsh): P2 geometry and hexahedra ---------------------------------
 GMSH_CASES = [("tetrahedron", 1), ("tetrahedron", 2), ("hexahedron", 1), ("hexahedron", 2)]
 
 

@@ -226,7 +226,7 @@ class Scene:
         return self._normal_cache[key]
 
     def interface_law(self, case: Case, p_seat: float):
-        """The interface law of ``case`` (pattern of demo_flat_punch.make_law, case (b))."""
+        """The interface law of ``case`` (pattern of rough_contact.scenes.flat_punch.make_law, case (b))."""
         from rough_contact.interface.friction import OrthotropicSlipHardening
         from rough_contact.interface.law import InterfaceLaw
         from rough_contact.interface.tangential import TangentialStiffness
