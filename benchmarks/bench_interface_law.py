@@ -25,8 +25,8 @@ import time
 
 import numpy as np
 
-from rough_contact.interface.friction import (IsotropicSlipHardening, OrthotropicSlipHardening,
-                                             _Columns)
+from rough_contact.interface.friction import (FrictionInput, IsotropicSlipHardening,
+                                             OrthotropicSlipHardening)
 from rough_contact.interface.law import InterfaceLaw
 from rough_contact.interface.normal import NormalLaw
 from rough_contact.interface.state import InterfaceState
@@ -48,7 +48,7 @@ def best_time(fn, repeat):
 def jumps(law, n, regime, rng):
     """Jumps (n, 3) and a committed state for one regime."""
     st = InterfaceState(rng.normal(size=(n, 2)) * 1e-4, rng.uniform(0, 1e-4, (n, 2)),
-                        rng.uniform(0, 1e-4, n), np.zeros(n))
+                        rng.uniform(0, 1e-4, n))
     g = rng.uniform(-2e-4, 2e-4, n)  # around the seating separation (contact)
     _, k, _ = law.normal.evaluate(law.h0 + g)
     kt_min = min(law.tangential.kt_over_kn) * k
@@ -68,7 +68,7 @@ def jumps(law, n, regime, rng):
         parts = [jumps(law, n // 3 + 1, r, rng) for r in ("stick", "slip", "open")]
         jj = np.concatenate([p_[0] for p_ in parts])[:n]
         cat = [np.concatenate([getattr(p_[1], a) for p_ in parts])[:n]
-               for a in ("plastic_slip", "accumulated_slip", "slip_path", "dissipated")]
+               for a in ("plastic_slip", "accumulated_slip", "slip_path")]
         return jj, InterfaceState(*cat)
     return np.column_stack([g, s]), st
 
@@ -103,15 +103,15 @@ def main(n=200_000, repeat=5):
                 cx, cy = ts.kt_over_kn
                 m = np.flatnonzero(p > 0)
                 sp, kap = st.plastic_slip[m], st.accumulated_slip[m]
-                cols = _Columns(jump[m, 1] - sp[:, 0], jump[m, 2] - sp[:, 1], cx * k[m], cy * k[m],
-                                cx * dk[m], cy * dk[m], p[m], k[m], kap[:, 0].copy(),
-                                kap[:, 1].copy(), st.slip_path[m])
+                cols = FrictionInput(jump[m, 1] - sp[:, 0], jump[m, 2] - sp[:, 1], cx * k[m],
+                                     cy * k[m], cx * dk[m], cy * dk[m], p[m], k[m],
+                                     kap[:, 0].copy(), kap[:, 1].copy(), st.slip_path[m])
                 out_t, out_D = np.empty((m.size, 2)), np.empty((m.size, 2, 3))
-                if m.size:  # the friction kernel as the law calls it (no validation)
-                    t_fr = best_time(lambda: fr._map(cols, out_t, out_D), repeat)
-                    res = fr._map(cols, out_t, out_D)
-                    slip = 0.0 if res is None else 100.0 * res.idx.size / n
-                    its = 0 if res is None else res.iterations
+                if m.size:  # the friction kernel as the law calls it (no value checks)
+                    t_fr = best_time(lambda: fr.evaluate(cols, out_t, out_D), repeat)
+                    res = fr.evaluate(cols, out_t, out_D)
+                    slip = 100.0 * res.slip_index.size / n
+                    its = res.iterations
                 else:
                     t_fr, slip, its = 0.0, 0.0, 0
                 rest = max(t_law - t_norm - t_fr, 0.0)

@@ -53,7 +53,7 @@ def drive(law: InterfaceLaw, slips: np.ndarray, g: float = 0.0) -> dict:
     for s in slips:
         r = law.evaluate(np.array([[g, s[0], s[1]]]), pair.committed)
         out["dsp"].append(r.state.plastic_slip[0] - pair.committed.plastic_slip[0])
-        pair.update(r.state)
+        pair.update(r)
         pair.commit()
         out["t"].append(r.traction[0, 1:])
         out["p"].append(r.pressure[0])

@@ -4,6 +4,7 @@ Model: R. Buczkowski and M. Kleiber, "Statistical Models of Rough Surfaces for F
 3D-Contact Analysis", Arch Comput Methods Eng 16 (2009) 399-424.
 
 Layers (each imports only those above it in this list):
+    validation                        check_scalar, the one input check of every layer
     surface, asperity, population     pure numpy/scipy rough-surface micro-model
     interface                         pure numpy interface laws at quadrature points
     fem, solver                       DOLFINx / PETSc (the only packages importing them)

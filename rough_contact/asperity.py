@@ -24,8 +24,8 @@ elasto-plastic mean pressure (75); ``ch = 0.967`` is the fully plastic pressure 
 (66); ``omega_p/omega_c = 45``. The hardness H and yield strength Y are related either as
 the user gives them, or (when only one is given) by the paper's conventions: from H,
 ``K_Y Y = (2/pi) H`` (the only reading under which the paper's nondimensional critical
-interference (74)/(87) follows from (65), (69), (70); see EQUATIONS.md); from Y, Tabor's
-``Y = 0.354 H`` (68).
+interference (74)/(87) follows from (65), (69), (70); see ``docs/equations.md``); from Y,
+Tabor's ``Y = 0.354 H`` (68).
 """
 from __future__ import annotations
 
@@ -35,6 +35,8 @@ from functools import lru_cache
 
 import numpy as np
 from scipy import special
+
+from .validation import check_scalar
 
 __all__ = [
     "AsperityMaterial", "elliptic_integrals", "eccentricity_from_lambda", "lambda_from_e1",
@@ -297,24 +299,16 @@ class AsperityMaterial:
     K_nu: float | None = None
 
     def __post_init__(self):
-        def pos(name, v):
-            if v is None:
-                return None
-            v = float(v)
-            if not math.isfinite(v) or v <= 0:
-                raise ValueError(f"{name} = {v!r} is invalid: it must be finite and > 0")
-            return v
-        object.__setattr__(self, "E_star", pos("E_star", self.E_star))
-        nu = float(self.nu)
-        if not (-1.0 < nu < 0.5):
-            raise ValueError(f"nu = {nu!r} is invalid: valid range is (-1, 0.5)")
+        def pos(name, v, unit=""):
+            return None if v is None else check_scalar(name, v, lo=0.0, unit=unit)
+        object.__setattr__(self, "E_star", pos("E_star", self.E_star, "MPa"))
+        nu = check_scalar("nu", self.nu, lo=-1.0, hi=0.5)
         object.__setattr__(self, "nu", nu)
-        for name in ("H", "Y", "psi", "ch", "K_Y", "K_nu"):
-            object.__setattr__(self, name, pos(name, getattr(self, name)))
-        r = float(self.omega_p_ratio)
-        if not math.isfinite(r) or r <= 1.0:
-            raise ValueError(f"omega_p_ratio = {r!r} is invalid: it must be finite and > 1")
-        object.__setattr__(self, "omega_p_ratio", r)
+        for name, unit in (("H", "MPa"), ("Y", "MPa"), ("psi", ""), ("ch", ""), ("K_Y", ""),
+                           ("K_nu", "")):
+            object.__setattr__(self, name, pos(name, getattr(self, name), unit))
+        object.__setattr__(self, "omega_p_ratio",
+                           check_scalar("omega_p_ratio", self.omega_p_ratio, lo=1.0))
         if self.H is not None and self.psi is not None:
             raise ValueError("H and psi are both given: give only one (psi determines H via (69))")
         if self.H is None and self.psi is None and self.Y is None:

@@ -1,9 +1,9 @@
 """Sums over the summit population: real area, load and stiffness vs separation.
 
 Implements the elastic model (52)-(55), the elasto-plastic model (78)-(85) with the exact
-stiffness -dW/dh (the Leibniz form of (88) corrected as in EQUATIONS.md: a boundary term at
-omega_c where the asperity load jumps), the bearing areas AG (24) and AB (25), and McCool's
-equivalent Greenwood-Williamson model (the "GW" columns of Tables 1-2).
+stiffness -dW/dh (the Leibniz form of (88), corrected as ``docs/equations.md`` explains: a
+boundary term at omega_c where the asperity load jumps), the bearing areas AG (24) and AB
+(25), and McCool's equivalent Greenwood-Williamson model (the "GW" columns of Tables 1-2).
 
 Units: separation h of the mean planes in mm; pressures W/A0 in MPa; stiffness per nominal
 area k_N = -d(W/A0)/dh in MPa/mm; area fractions A/A0 dimensionless.
@@ -52,6 +52,7 @@ from scipy import special
 from .asperity import (AsperityMaterial, eccentricity_from_lambda, shape_factors,
                        shape_factors_from_lambda)
 from .surface import SpectralMoments
+from .validation import check_scalar
 
 __all__ = ["PopulationResult", "elastic", "elasto_plastic", "greenwood_williamson",
            "bearing_area", "bearing_area_ratio", "F_n", "log_F_n"]
@@ -144,18 +145,11 @@ def _check_h(h):
     return h
 
 
-def _check_pos(name, v):
-    v = float(v)
-    if not math.isfinite(v) or v <= 0:
-        raise ValueError(f"{name} = {v!r} is invalid: it must be finite and > 0")
-    return v
-
-
 def _check_nquad(n):
-    n = int(n)
-    if n < 4 or n > 400:
-        raise ValueError(f"n_quad = {n} is invalid: valid range is [4, 400]")
-    return n
+    v = check_scalar("n_quad", n, lo=4, hi=400, lo_open=False, hi_open=False)
+    if v != int(v):
+        raise ValueError(f"n_quad = {n!r} is invalid: it must be an integer in [4, 400]")
+    return int(v)
 
 
 @lru_cache(maxsize=16)
@@ -299,7 +293,7 @@ def elastic(surface: SpectralMoments, E_star: float, h, n_quad: int = 32,
     Returns:
         PopulationResult (area_fraction, pressure [MPa], stiffness [MPa/mm]) shaped like h.
     """
-    E_star = _check_pos("E_star", E_star)
+    E_star = check_scalar("E_star", E_star, lo=0.0, unit="MPa")
     n_quad = _check_nquad(n_quad)
     h = _check_h(h)
     shape = h.shape
@@ -449,7 +443,7 @@ def greenwood_williamson(surface: SpectralMoments, E_star: float, h) -> Populati
     Args:
         surface: spectral moments; E_star [MPa]; h separations [mm].
     """
-    E_star = _check_pos("E_star", E_star)
+    E_star = check_scalar("E_star", E_star, lo=0.0, unit="MPa")
     h = _check_h(h)
     m2 = math.sqrt(surface.m20 * surface.m02)
     m4 = math.sqrt(surface.m40 * surface.m04)

@@ -5,7 +5,7 @@ The surface is described by five spectral moments (Bush, Gibson & Keogh; eqs 7-1
 the grain) and ``m40, m04`` (mean-square curvatures). From them follow the bandwidths (10-11),
 the summit density (17), the joint summit pdf (18), the mean summit curvature (70), the
 summit-height standard deviation (71-72), the summit mean-plane offset (73) and the plasticity
-index (69). Readings of misprinted equations follow ``EQUATIONS.md`` (see each property).
+index (69). Misprinted equations are read as stated in ``docs/equations.md`` (see each property).
 
 Units. The whole package works in **mm, N, MPa**. At the API boundary the moments are
 accepted in the paper's micrometre convention (``unit="um"``: m00 in um^2, m20/m02
@@ -29,16 +29,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .validation import check_scalar
+
 __all__ = ["SpectralMoments", "moments_from_height_map", "psum", "plasticity_index"]
 
 _UNIT_SCALE = {"um": 1.0e-3, "mm": 1.0, "m": 1.0e3}  # length unit -> mm
-
-
-def _check_positive(name: str, value: float) -> float:
-    value = float(value)
-    if not math.isfinite(value) or value <= 0.0:
-        raise ValueError(f"{name} = {value!r} is invalid: it must be finite and > 0")
-    return value
 
 
 # m04/m40 below which SpectralMoments warns that the strongly anisotropic model is out of range.
@@ -76,7 +71,8 @@ class SpectralMoments:
         if self.unit not in _UNIT_SCALE:
             raise ValueError(f"unit = {self.unit!r} is invalid: valid units are {sorted(_UNIT_SCALE)}")
         L = _UNIT_SCALE[self.unit]
-        vals = {n: _check_positive(n, getattr(self, n)) for n in ("m00", "m20", "m02", "m40", "m04")}
+        vals = {n: check_scalar(n, getattr(self, n), lo=0.0)
+                for n in ("m00", "m20", "m02", "m40", "m04")}
         object.__setattr__(self, "m00", vals["m00"] * L**2)
         object.__setattr__(self, "m20", vals["m20"])
         object.__setattr__(self, "m02", vals["m02"])
@@ -163,8 +159,8 @@ class SpectralMoments:
 
     def hardness_for_plasticity_index(self, E_star: float, psi: float) -> float:
         """Hardness H [MPa] giving plasticity index psi for this surface and E* (inverse of (69))."""
-        E_star = _check_positive("E_star", E_star)
-        psi = _check_positive("psi", psi)
+        E_star = check_scalar("E_star", E_star, lo=0.0, unit="MPa")
+        psi = check_scalar("psi", psi, lo=0.0)
         return math.sqrt(self.summit_sigma * self.mean_summit_curvature) * E_star / psi
 
     def psum(self, w1, w4, w6):
@@ -185,13 +181,13 @@ def plasticity_index(surface: SpectralMoments, E_star: float, H: float) -> float
         E_star: effective modulus (42) [MPa].
         H: hardness [MPa].
     """
-    E_star = _check_positive("E_star", E_star)
-    H = _check_positive("H", H)
+    E_star = check_scalar("E_star", E_star, lo=0.0, unit="MPa")
+    H = check_scalar("H", H, lo=0.0, unit="MPa")
     return math.sqrt(surface.summit_sigma * surface.mean_summit_curvature) * E_star / H
 
 
 def psum(w1, w4, w6, beta1: float, beta2: float):
-    """Joint pdf of summit height and curvatures, eq (18) as read in EQUATIONS.md.
+    """Joint pdf of summit height and curvatures, eq (18) as read in ``docs/equations.md``.
 
     psum = mu^2/sqrt(2 pi) w4 w6 exp(-X/2),
     X = (w1 - sqrt(beta1) w4 - sqrt(beta2) w6)^2 + mu (w4^2 + w6^2),
@@ -239,8 +235,8 @@ def moments_from_height_map(z, dx: float, dy: float | None = None, method: str =
         raise ValueError(f"z.shape = {z.shape} is invalid: a 2D map of at least 3x3 samples is needed")
     if not np.all(np.isfinite(z)):
         raise ValueError("z contains NaN/inf values: all heights must be finite")
-    dx = _check_positive("dx", dx)
-    dy = dx if dy is None else _check_positive("dy", dy)
+    dx = check_scalar("dx", dx, lo=0.0)
+    dy = dx if dy is None else check_scalar("dy", dy, lo=0.0)
     z = z - z.mean()
     nx, ny = z.shape
     if method == "fft":

@@ -3,7 +3,11 @@
 This module is the hand-off between the pure-numpy laws (``rough_contact.interface``) and the
 finite-element layer (``rough_contact.fem.contact.ContactInterface``). A law written by a user
 plugs in by satisfying :class:`InterfaceLawProtocol` and returning :class:`LawResult`; nothing
-else is looked up on it. ``docs/writing_a_law.md`` walks through a complete user law.
+else is looked up on it. ``docs/writing_a_law.md`` states the contract in prose and walks
+through a complete user law. Pure module: numpy only.
+
+A law is called once per evaluation with ALL interface points of a rank, as arrays (batch
+first); a rank may own no point, so n = 0 must work and give empty arrays.
 
 Units: mm, N, MPa. Jumps and gaps [mm]; tractions and pressures [MPa]; stiffnesses per nominal
 area [MPa/mm]; dissipation per nominal area [N/mm] (= MPa mm).
@@ -17,31 +21,46 @@ At every interface point the FE layer builds an orthonormal frame (n, x, y):
 * y = n x x.
 
 ``jump`` (n_pts, 3) holds ``[g, s_x, s_y]``, the components of u_second - u_first in that frame
-(plus the initial gap for a rigid obstacle). g > 0 opens the interface.
+(plus the initial gap for a rigid obstacle). g > 0 opens the interface; s is the tangential
+slip.
 
 Traction and tangent
 --------------------
-The traction is energy-conjugate to the jump, ``t = dpsi/djump`` for the interface free energy
-psi, so in compression ``t_N = -p <= 0`` and the friction traction points along the elastic
-slip. The FE residual is ``R = int B^T t dA`` and the Jacobian ``int B^T D B dA`` with
-``D = dt/djump`` (n_pts, 3, 3) the ALGORITHMIC tangent of the discrete (backward-Euler) update,
-which is non-symmetric for non-associated friction. A wrong tangent costs Newton iterations but
-never changes a converged answer.
+``traction`` (n_pts, 3) = ``[t_N, t_x, t_y]`` is energy-conjugate to the jump,
+``t = dpsi/djump`` for the interface free energy psi per nominal area, so in compression
+``t_N = -p <= 0`` and the friction traction points along the elastic slip. The FE residual is
+``R = int B^T t dA`` and the Jacobian ``int B^T D B dA`` with ``D = dt/djump`` (n_pts, 3, 3)
+(row: traction component, column: jump component; ``D[:, 0, 0] = -dp/dg >= 0``), the
+ALGORITHMIC tangent of the discrete update the law computes, including the coupling of the
+friction traction to the normal jump; it is non-symmetric for friction. A wrong tangent costs
+Newton iterations but never changes a converged answer.
 
 History
 -------
 ``evaluate`` is a pure function of ``(jump, committed)``: it must never mutate ``committed``
 (SNES line searches evaluate trial points that are thrown away). It returns the trial state
-that the interface stores; the interface commits it once per converged increment and drops it
-on a cutback. The law reports the dissipation INCREMENT of the step, ``t_T . Delta s_p``
-per nominal area; the interface accumulates it (one place).
+(a :class:`LawState`, a new object) that the interface stores; the interface commits it once
+per converged increment and drops it on a cutback. The law reports the dissipation INCREMENT
+of the step, ``t_T . Delta s_p >= 0`` per nominal area; the owner of the history accumulates it
+(``ContactInterface``, or ``rough_contact.interface.state.StatePair`` at a material point),
+never the law.
 
 Failures
 --------
 A law raises :class:`ConvergenceError` (or a subclass, e.g. the friction return map's
 ``ReturnMappingError``) when a smaller load increment may cure the failure: the load stepping
-then cuts back. Any other exception (bad input, programming error) propagates at once with its
-own type and traceback.
+then cuts back. A non-finite jump is such a failure (a diverging global iterate), so
+:func:`check_jump` raises ``ConvergenceError`` for it. Any other exception (bad input such as a
+wrong shape: ``ValueError``; a programming error) propagates at once with its own type and
+traceback.
+
+Built-in laws
+-------------
+``rough_contact.interface.law.InterfaceLaw`` (rough surface + friction) and
+``rough_contact.interface.penalty.LinearPenalty`` / ``SoftplusPenalty`` follow this contract and
+keep their history in ``rough_contact.interface.state.InterfaceState``;
+``rough_contact.interface.state.StatePair`` is the committed/trial bookkeeping that sums the
+dissipation increments.
 """
 
 from __future__ import annotations
@@ -52,7 +71,7 @@ from typing import Protocol, TypeVar, runtime_checkable
 import numpy as np
 
 __all__ = ["ConvergenceError", "LawState", "LawResult", "InterfaceLawProtocol",
-           "LawContractError"]
+           "LawContractError", "check_jump"]
 
 
 class ConvergenceError(ArithmeticError):
@@ -125,6 +144,7 @@ class LawResult:
         fields = (("traction", (n, 3), np.floating), ("tangent", (n, 3, 3), np.floating),
                   ("dissipation", (n,), np.floating), ("area_fraction", (n,), np.floating),
                   ("contact", (n,), np.bool_), ("slipping", (n,), np.bool_))
+        kind_names = {np.floating: "a floating-point dtype", np.bool_: "bool"}
         for name, shape, kind in fields:
             value = getattr(self, name)
             if not isinstance(value, np.ndarray):
@@ -135,7 +155,7 @@ class LawResult:
                                        f"needs {shape} for {n} points")
             if not np.issubdtype(value.dtype, kind):
                 raise LawContractError(f"LawResult.{name} has dtype {value.dtype}, the contract "
-                                       f"needs {np.dtype(kind).name}")
+                                       f"needs {kind_names[kind]}")
         if not isinstance(self.state, LawState):
             raise LawContractError(
                 f"LawResult.state ({type(self.state).__name__}) must have a plastic_slip array, "
@@ -162,3 +182,33 @@ class InterfaceLawProtocol(Protocol):
             ValueError: bad input (wrong shapes, unset parameters).
         """
         ...
+
+
+def check_jump(jump, committed: LawState) -> np.ndarray:
+    """Validate the arguments of ``evaluate`` as the contract requires; return the jump.
+
+    Args:
+        jump: (n, 3) [g, s_x, s_y] [mm].
+        committed: the committed state; must hold n points.
+
+    Returns:
+        ``jump`` as a float array (n, 3) (no copy if it already is one).
+
+    Raises:
+        ValueError: ``jump`` is not (n, 3), or ``committed`` is not a ``LawState`` of n points.
+        ConvergenceError: ``jump`` is not finite somewhere (names the count and the first index).
+    """
+    jump = np.asarray(jump, dtype=float)
+    if jump.ndim != 2 or jump.shape[1] != 3:
+        raise ValueError(f"jump must have shape (n_pts, 3), got {jump.shape}")
+    n = jump.shape[0]
+    if not isinstance(committed, LawState) or len(committed) != n:
+        got = (f"{len(committed)} points" if isinstance(committed, LawState)
+               else type(committed).__name__)
+        raise ValueError(f"committed state must be a LawState with {n} points (as jump), "
+                         f"got {got}")
+    if not np.isfinite(jump).all():
+        bad = np.flatnonzero(~np.isfinite(jump).all(axis=1))
+        raise ConvergenceError(f"jump is not finite at {bad.size} of {n} points (first index "
+                               f"{bad[0]}): a diverging global iterate")
+    return jump

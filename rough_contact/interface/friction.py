@@ -24,7 +24,7 @@ Isotropic model, paper section 8.2
 (119) mu_F = mu_m [1 - (1 - beta) exp(-n kappa)], kappa = effective plastic slip (path length),
 (120) f = ||t_T|| - mu_F p,  (121) circular potential (slip coaxial with the traction).
 
-Decisions (documented in the README):
+Decisions (documented in ``docs/equations.md``):
     * Elastic part in TOTAL form: t_T = K_T(h) (s - s_p), K_T = diag(kTx, kTy), kT_i = c_i kN(h)
       (``tangential.TangentialStiffness``). On opening (kN -> 0) the elastic slip is released and
       the plastic slip s_p is kept. The tangent therefore contains dK_T/dg = c_i dkN/dh.
@@ -50,8 +50,15 @@ Decisions (documented in the README):
       coupling to the normal jump through p(h) and kT(h); ``continuum_tangent`` gives the paper's
       (107)-(110) for comparison.
 
-Sign convention (see common.md): t = dpsi/djump, jump = (g, s_x, s_y), t_N = -p, so the friction
-traction t_T points along the elastic slip s - s_p (it resists the motion of the second body).
+Sign convention (the interface-law contract, ``rough_contact.interface.contract``):
+t = dpsi/djump, jump = (g, s_x, s_y), t_N = -p, so the friction traction t_T points along the
+elastic slip s - s_p (it resists the motion of the second body). ``docs/equations.md`` lists
+the readings of (89)-(131) used here.
+
+Entry points: ``evaluate(FrictionInput, traction=, tangent=) -> FrictionOutput`` is what the
+composed law (``rough_contact.interface.law.InterfaceLaw``) calls at every evaluation (shapes
+checked, values trusted, results written into the caller's arrays); ``return_map`` takes
+(m, 2) pairs, validates every value and returns a dense ``FrictionResult``.
 """
 
 from __future__ import annotations
@@ -61,9 +68,14 @@ from typing import Optional, Tuple
 
 import numpy as np
 
+from ..validation import check_scalar
+from .contract import ConvergenceError
+
 __all__ = [
     "OrthotropicSlipHardening",
     "IsotropicSlipHardening",
+    "FrictionInput",
+    "FrictionOutput",
     "FrictionResult",
     "ReturnMappingError",
     "continuum_tangent",
@@ -77,8 +89,11 @@ _MAX_ITER = 80
 _RELEASE = 1e-16  # p < 1e-16 N_trial min(a)/max(a): closed-form release limit (no overflow)
 
 
-class ReturnMappingError(RuntimeError):
-    """The local Newton of the return map did not converge at some points."""
+class ReturnMappingError(ConvergenceError):
+    """The local Newton of the return map did not converge at some points.
+
+    A ``ConvergenceError``: a smaller load increment (a smaller slip increment) usually cures it.
+    """
 
 
 @dataclass(frozen=True)
@@ -100,69 +115,130 @@ class FrictionResult:
     iterations: int = 0
 
 
-@dataclass
-class _Columns:
-    """Per-point inputs of the return map as 1-D columns (internal; no validation).
+@dataclass(frozen=True)
+class FrictionInput:
+    """What a friction law's return map needs at m contact points, as 1-D columns (m,).
 
-    ex, ey: elastic trial slip s - s_p [mm]; kx, ky: kT [MPa/mm]; dkx, dky: dkT/dg [MPa/mm^2];
-    p: pressure [MPa]; kn: -dp/dg [MPa/mm]; kapx, kapy: accumulated |slip| [mm];
-    path: effective plastic slip [mm].
+    The composed law (``rough_contact.interface.law.InterfaceLaw``) fills it from the normal
+    law, the tangential stiffness and the committed history; ``evaluate`` reads it and never
+    writes to it. Columns rather than (m, 2) pairs so that the caller can hand over views and
+    the return map can gather the slipping subset with one ``take`` per column.
+
+    Attributes:
+        elastic_slip_x, elastic_slip_y: trial elastic slip e = s - s_p(committed) [mm].
+        kt_x, kt_y: tangential stiffnesses kT_i = c_i kN(h) > 0 [MPa/mm].
+        dkt_x, dkt_y: their derivatives d kT_i / d g = c_i dkN/dh [MPa/mm^2].
+        pressure: contact pressure p >= 0 [MPa].
+        kn: normal stiffness kN = -dp/dg >= 0 [MPa/mm].
+        kappa_x, kappa_y: committed accumulated slip magnitudes, hardening variables of the
+            orthotropic law (89)-(90) [mm].
+        slip_path: committed effective plastic slip (path length), hardening variable of the
+            isotropic law (119) [mm].
+
+    Raises:
+        ValueError: a column that is not a 1-D array, or columns of different lengths. Values
+            are not checked here (``evaluate`` is the hot path; ``return_map`` checks them).
     """
 
-    ex: np.ndarray
-    ey: np.ndarray
-    kx: np.ndarray
-    ky: np.ndarray
-    dkx: np.ndarray
-    dky: np.ndarray
-    p: np.ndarray
+    elastic_slip_x: np.ndarray
+    elastic_slip_y: np.ndarray
+    kt_x: np.ndarray
+    kt_y: np.ndarray
+    dkt_x: np.ndarray
+    dkt_y: np.ndarray
+    pressure: np.ndarray
     kn: np.ndarray
-    kapx: np.ndarray
-    kapy: np.ndarray
-    path: np.ndarray
+    kappa_x: np.ndarray
+    kappa_y: np.ndarray
+    slip_path: np.ndarray
 
-    def take(self, idx) -> _Columns:
-        return _Columns(*(getattr(self, f).take(idx) for f in self.__dataclass_fields__))
+    def __post_init__(self) -> None:
+        m = np.shape(self.elastic_slip_x)[0] if np.ndim(self.elastic_slip_x) == 1 else -1
+        for name in self.__dataclass_fields__:
+            v = getattr(self, name)
+            if not isinstance(v, np.ndarray) or v.ndim != 1 or v.shape[0] != m:
+                raise ValueError(f"FrictionInput.{name} must be a 1-D array of the same length "
+                                 f"as elastic_slip_x ({m}), got shape {np.shape(v)}")
+
+    def __len__(self) -> int:
+        return self.elastic_slip_x.shape[0]
+
+    def take(self, idx) -> FrictionInput:
+        """The columns at points ``idx`` (a gathered copy)."""
+        return FrictionInput(*(getattr(self, f).take(idx) for f in self.__dataclass_fields__))
 
 
-@dataclass
-class _Slip:
-    """Return-map output at the slipping points idx (internal)."""
+@dataclass(frozen=True)
+class FrictionOutput:
+    """Outcome of ``evaluate`` at m contact points; slip data only where the limit is active.
 
-    idx: np.ndarray
-    dspx: np.ndarray
-    dspy: np.ndarray
+    Attributes:
+        traction: (m, 2) tangential traction (t_x, t_y) [MPa] (the array given as ``traction=``
+            to ``evaluate``, if any).
+        tangent: (m, 2, 3) algorithmic tangent d t_T / d(g, s_x, s_y) [MPa/mm] (likewise).
+        slip_index: (k,) int, ascending indices in [0, m) of the points that slip.
+        plastic_increment_x, plastic_increment_y: (k,) Delta s_p at those points [mm].
+        path_increment: (k,) ||Delta s_p|| [mm] (increment of the isotropic law's kappa, (119)).
+        iterations: local Newton iterations used (0 if nothing slipped).
+    """
+
+    traction: np.ndarray
+    tangent: np.ndarray
+    slip_index: np.ndarray
+    plastic_increment_x: np.ndarray
+    plastic_increment_y: np.ndarray
+    path_increment: np.ndarray
     iterations: int
 
 
+_NO_SLIP = np.zeros(0, dtype=np.intp)
+_NO_SLIP.flags.writeable = False
+_NO_INCREMENT = np.zeros(0)
+_NO_INCREMENT.flags.writeable = False
+
+
+def _no_slip(traction, tangent) -> FrictionOutput:
+    return FrictionOutput(traction, tangent, _NO_SLIP, _NO_INCREMENT, _NO_INCREMENT,
+                          _NO_INCREMENT, 0)
+
+
+def _outputs(points: FrictionInput, traction, tangent):
+    """Check (or allocate) the arrays ``evaluate`` writes into."""
+    if not isinstance(points, FrictionInput):
+        raise ValueError(f"points must be a FrictionInput, got {type(points).__name__}")
+    m = len(points)
+    if traction is None:
+        traction = np.empty((m, 2))
+    elif not (isinstance(traction, np.ndarray) and traction.shape == (m, 2)
+              and traction.dtype == np.float64):
+        raise ValueError(f"traction must be a float64 array of shape ({m}, 2), got "
+                         f"{getattr(traction, 'dtype', type(traction).__name__)} "
+                         f"{np.shape(traction)}")
+    if tangent is None:
+        tangent = np.empty((m, 2, 3))
+    elif not (isinstance(tangent, np.ndarray) and tangent.shape == (m, 2, 3)
+              and tangent.dtype == np.float64):
+        raise ValueError(f"tangent must be a float64 array of shape ({m}, 2, 3), got "
+                         f"{getattr(tangent, 'dtype', type(tangent).__name__)} "
+                         f"{np.shape(tangent)}")
+    return traction, tangent
+
+
 # ----------------------------------------------------------------------------- validation
-def _pair(name: str, value, lo: float, hi: float, lo_open: bool, hi_open: bool = True):
-    arr = np.asarray(value, dtype=float)
+def _pair(name: str, value, **bounds) -> Tuple[float, float]:
+    """(x, y) pair of parameters, each checked by ``check_scalar`` (a scalar applies to both)."""
+    try:
+        arr = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        arr = np.full(3, np.nan)  # not numeric: reported as not a pair below
     if arr.ndim == 0:
         arr = np.array([arr, arr], dtype=float)
     if arr.shape != (2,):
         raise ValueError(f"{name} must be a scalar or a pair (x, y), got {value!r}")
-    for axis, v in zip("xy", arr):
-        ok = (np.isfinite(v) and (v > lo if lo_open else v >= lo)
-              and (v < hi if hi_open else v <= hi))
-        if not ok:
-            lb = "(" if lo_open else "["
-            rb = ")" if hi_open else "]"
-            raise ValueError(f"{name}[{axis}] = {v!r} must lie in {lb}{lo}, {hi}{rb}")
-    return float(arr[0]), float(arr[1])
+    return tuple(check_scalar(f"{name}[{axis}]", float(v), **bounds) for axis, v in zip("xy", arr))
 
 
-def _scalar(name: str, value, lo: float, hi: float, lo_open: bool, hi_open: bool = True) -> float:
-    v = float(value)
-    ok = np.isfinite(v) and (v > lo if lo_open else v >= lo) and (v < hi if hi_open else v <= hi)
-    if not ok:
-        lb = "(" if lo_open else "["
-        rb = ")" if hi_open else "]"
-        raise ValueError(f"{name} = {value!r} must lie in {lb}{lo}, {hi}{rb}")
-    return v
-
-
-def _columns(elastic_slip, kt, dkt, pressure, kn, accumulated_slip, slip_path) -> _Columns:
+def _columns(elastic_slip, kt, dkt, pressure, kn, accumulated_slip, slip_path) -> FrictionInput:
     e = np.asarray(elastic_slip, dtype=float)
     if e.ndim != 2 or e.shape[1] != 2:
         raise ValueError(f"elastic_slip must have shape (m, 2), got {e.shape}")
@@ -187,23 +263,20 @@ def _columns(elastic_slip, kt, dkt, pressure, kn, accumulated_slip, slip_path) -
     if np.any(arrs["kn"] < 0):
         raise ValueError("kn (normal stiffness) must be >= 0 at every point [MPa/mm]")
     kt, dkt, kap = arrs["kt"], arrs["dkt"], arrs["accumulated_slip"]
-    return _Columns(e[:, 0].copy(), e[:, 1].copy(), kt[:, 0].copy(), kt[:, 1].copy(),
+    return FrictionInput(e[:, 0].copy(), e[:, 1].copy(), kt[:, 0].copy(), kt[:, 1].copy(),
                     dkt[:, 0].copy(), dkt[:, 1].copy(), arrs["pressure"], arrs["kn"],
                     kap[:, 0].copy(), kap[:, 1].copy(), arrs["slip_path"])
 
 
-def _public_result(law, c: _Columns) -> FrictionResult:
-    m = c.ex.shape[0]
-    traction = np.empty((m, 2))
-    tangent = np.empty((m, 2, 3))
-    slip = law._map(c, traction, tangent)
+def _public_result(law, c: FrictionInput) -> FrictionResult:
+    out = law.evaluate(c)
+    m = len(c)
     dsp = np.zeros((m, 2))
     slipping = np.zeros(m, dtype=bool)
-    if slip is not None:
-        dsp[slip.idx, 0] = slip.dspx
-        dsp[slip.idx, 1] = slip.dspy
-        slipping[slip.idx] = True
-    return FrictionResult(traction, tangent, dsp, slipping, 0 if slip is None else slip.iterations)
+    dsp[out.slip_index, 0] = out.plastic_increment_x
+    dsp[out.slip_index, 1] = out.plastic_increment_y
+    slipping[out.slip_index] = True
+    return FrictionResult(out.traction, out.tangent, dsp, slipping, out.iterations)
 
 
 def _norm(x, y):
@@ -283,18 +356,18 @@ def _initial_bracket(excess_num, p, ax, ay, qx2, qy2, n_lo):
     return lam0, lo, hi
 
 
-def _write_stick(c: _Columns, out_t, out_D):
+def _write_stick(c: FrictionInput, out_t, out_D):
     """Elastic (stick) values at every point: t = K_T e, dt/d(g, s) = [dK_T e, K_T]."""
-    tx = c.kx * c.ex
-    ty = c.ky * c.ey
+    tx = c.kt_x * c.elastic_slip_x
+    ty = c.kt_y * c.elastic_slip_y
     out_t[:, 0] = tx
     out_t[:, 1] = ty
-    out_D[:, 0, 0] = c.dkx * c.ex
-    out_D[:, 0, 1] = c.kx
+    out_D[:, 0, 0] = c.dkt_x * c.elastic_slip_x
+    out_D[:, 0, 1] = c.kt_x
     out_D[:, 0, 2] = 0.0
-    out_D[:, 1, 0] = c.dky * c.ey
+    out_D[:, 1, 0] = c.dkt_y * c.elastic_slip_y
     out_D[:, 1, 1] = 0.0
-    out_D[:, 1, 2] = c.ky
+    out_D[:, 1, 2] = c.kt_y
     return tx, ty
 
 
@@ -305,19 +378,19 @@ def _write_slip(idx, out_t, out_D, tx, ty, D):
         out_D[idx, i, j] = v
 
 
-def _tangent(c: _Columns, tx, ty, lam, wx, wy, Dx, Dy, bx, by, c0):
+def _tangent(c: FrictionInput, tx, ty, lam, wx, wy, Dx, Dy, bx, by, c0):
     """Algorithmic tangent rows d t_T / d(g, s_x, s_y) at slipping points.
 
     t_i = t_trial,i / D_i with D_i = 1 + lam kT_i w_i and the scalar equation F = N - p = 0;
     dt_i = r_i - v_i dlam,  r_i = [dt_trial,i - t_i w_i lam dkT_i]/D_i,  v_i = t_i w_i kT_i/D_i,
     dlam = (sum_i b_i r_i - dp)/den,  den = sum_i b_i v_i - c0 = -dN/dlam > 0,  dp/dg = -kN.
     """
-    rsx = c.kx / Dx
-    rsy = c.ky / Dy
+    rsx = c.kt_x / Dx
+    rsy = c.kt_y / Dy
     lwx = lam * wx
     lwy = lam * wy
-    rgx = c.dkx * (c.ex - lwx * tx) / Dx
-    rgy = c.dky * (c.ey - lwy * ty) / Dy
+    rgx = c.dkt_x * (c.elastic_slip_x - lwx * tx) / Dx
+    rgy = c.dkt_y * (c.elastic_slip_y - lwy * ty) / Dy
     vx = tx * wx * rsx  # = t_x w_x kTx / D_x
     vy = ty * wy * rsy
     inv = 1.0 / (bx * vx + by * vy - c0)
@@ -333,7 +406,7 @@ def _spread(ax, ay):
     return np.minimum(ax, ay) / np.maximum(ax, ay)
 
 
-def _released(c: _Columns, ux, uy, mux, muy):
+def _released(c: FrictionInput, ux, uy, mux, muy):
     """Limit p << |t_trial| (p/N_trial < 1e-16 min(a)/max(a)): all elastic slip turns plastic.
 
     The exact map gives t = t_trial/(1 + lam a) with lam a_i ~ N_trial/p; to double precision
@@ -346,11 +419,11 @@ def _released(c: _Columns, ux, uy, mux, muy):
         pos = nrm > 0
         dx = np.where(pos, ux / nrm, 0.0)
         dy = np.where(pos, uy / nrm, 0.0)
-    tx = c.p * dx
-    ty = c.p * dy
+    tx = c.pressure * dx
+    ty = c.pressure * dy
     D = {(0, 0): -c.kn * dx, (0, 1): 0.0, (0, 2): 0.0, (1, 0): -c.kn * dy, (1, 1): 0.0,
          (1, 2): 0.0}
-    return tx, ty, c.ex - tx / c.kx, c.ey - ty / c.ky, D
+    return tx, ty, c.elastic_slip_x - tx / c.kt_x, c.elastic_slip_y - ty / c.kt_y, D
 
 
 # ----------------------------------------------------------------------------- orthotropic
@@ -379,18 +452,18 @@ class OrthotropicSlipHardening:
 
     def __post_init__(self) -> None:
         s = object.__setattr__
-        s(self, "mu_macro", _pair("mu_macro", self.mu_macro, 0.0, np.inf, True))
+        s(self, "mu_macro", _pair("mu_macro", self.mu_macro, lo=0.0))
         s(self, "mu_initial_ratio",
-          _pair("mu_initial_ratio", self.mu_initial_ratio, 0.0, 1.0, True, hi_open=False))
-        s(self, "hardening", _pair("hardening", self.hardening, 0.0, np.inf, False))
+          _pair("mu_initial_ratio", self.mu_initial_ratio, lo=0.0, hi=1.0, hi_open=False))
+        s(self, "hardening", _pair("hardening", self.hardening, lo=0.0, lo_open=False, unit="1/mm"))
         if self.potential_axes is not None and self.potential_exponent is not None:
             raise ValueError("give either potential_axes or potential_exponent, not both")
         if self.potential_axes is not None:
             s(self, "potential_axes",
-              _pair("potential_axes", self.potential_axes, 0.0, np.inf, True))
+              _pair("potential_axes", self.potential_axes, lo=0.0))
         if self.potential_exponent is not None:
             s(self, "potential_exponent",
-              _scalar("potential_exponent", self.potential_exponent, -np.inf, np.inf, True))
+              check_scalar("potential_exponent", self.potential_exponent))
 
     # -- coefficients ---------------------------------------------------------------------
     def _mu(self, kapx, kapy):
@@ -445,26 +518,49 @@ class OrthotropicSlipHardening:
         return _public_result(self, _columns(elastic_slip, kt, dkt, pressure, kn,
                                              accumulated_slip, slip_path))
 
-    def _map(self, c: _Columns, out_t, out_D) -> Optional[_Slip]:
-        """Write traction/tangent into out_t (m, 2), out_D (m, 2, 3) views; return slip data."""
-        mux, _, muy, _ = self._mu(c.kapx, c.kapy)
+    def evaluate(self, points: FrictionInput, traction: Optional[np.ndarray] = None,
+                 tangent: Optional[np.ndarray] = None) -> FrictionOutput:
+        """Backward-Euler return map and algorithmic tangent at m contact points (hot path).
+
+        Pure: ``points`` is read, never written. The results are written into ``traction`` and
+        ``tangent`` when given (e.g. views into the composed law's (n, 3) and (n, 3, 3) arrays,
+        which saves a copy), else into new arrays. Only shapes are checked here; the values are
+        trusted (finite, p >= 0, kT > 0: what the composed law produces from a finite jump);
+        ``return_map`` is the validated entry point for other callers.
+
+        Args:
+            points: the inputs at m points (``FrictionInput``).
+            traction: optional (m, 2) float64 output for (t_x, t_y) [MPa].
+            tangent: optional (m, 2, 3) float64 output for d t_T / d(g, s_x, s_y) [MPa/mm].
+
+        Returns:
+            ``FrictionOutput``: traction and tangent at all m points, and the plastic slip
+            increments at the k slipping points.
+
+        Raises:
+            ValueError: wrong types or shapes. ReturnMappingError (a ``ConvergenceError``): the
+                local Newton did not converge.
+        """
+        out_t, out_D = _outputs(points, traction, tangent)
+        c = points
+        mux, _, muy, _ = self._mu(c.kappa_x, c.kappa_y)
         tx, ty = _write_stick(c, out_t, out_D)
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-            qx = tx / (mux * c.p)
-            qy = ty / (muy * c.p)
+            qx = tx / (mux * c.pressure)
+            qy = ty / (muy * c.pressure)
             slipping = qx * qx + qy * qy > 1.0
         if not slipping.any():
-            return None
+            return _no_slip(out_t, out_D)
         idx = np.flatnonzero(slipping)
         s = c.take(idx)
         mux_s = mux if np.isscalar(mux) else mux.take(idx)
         muy_s = muy if np.isscalar(muy) else muy.take(idx)
         wx, wy = self._weights(mux_s, muy_s)
         cx, cy = tx.take(idx), ty.take(idx)
-        ax = s.kx * wx
-        ay = s.ky * wy
+        ax = s.kt_x * wx
+        ay = s.kt_y * wy
         ntr = _norm(cx / mux_s, cy / muy_s)
-        released = ntr * (_RELEASE * _spread(ax, ay)) > s.p
+        released = ntr * (_RELEASE * _spread(ax, ay)) > s.pressure
         dspx = np.empty(idx.size)
         dspy = np.empty(idx.size)
         its = 0
@@ -472,8 +568,9 @@ class OrthotropicSlipHardening:
             r = np.flatnonzero(released)
             sr = s.take(r)
             wyr = wy if np.isscalar(wy) else wy.take(r)
-            ux, uy = sr.ex / wx, sr.ey / wyr
-            mx, _, my, _ = self._mu(sr.kapx + np.abs(sr.ex), sr.kapy + np.abs(sr.ey))
+            ux, uy = sr.elastic_slip_x / wx, sr.elastic_slip_y / wyr
+            mx, _, my, _ = self._mu(sr.kappa_x + np.abs(sr.elastic_slip_x),
+                                    sr.kappa_y + np.abs(sr.elastic_slip_y))
             rtx, rty, dspx[r], dspy[r], D = _released(sr, ux, uy, mx, my)
             _write_slip(idx[r], out_t, out_D, rtx, rty, D)
         if not released.all():
@@ -488,25 +585,25 @@ class OrthotropicSlipHardening:
                 res = self._slip(s, mux_s, muy_s, wy, cx, cy, ntr, ax, ay)
             gtx, gty, dspx[g], dspy[g], D, its = res
             _write_slip(idx[g], out_t, out_D, gtx, gty, D)
-        return _Slip(idx, dspx, dspy, its)
+        return FrictionOutput(out_t, out_D, idx, dspx, dspy, _norm(dspx, dspy), its)
 
-    def _slip(self, s: _Columns, mux_n, muy_n, wy, cx, cy, ntr, ax, ay):
+    def _slip(self, s: FrictionInput, mux_n, muy_n, wy, cx, cy, ntr, ax, ay):
         mmx, mmy = self.mu_macro
         wx = 1.0
         acx, acy = np.abs(cx), np.abs(cy)
         qx2 = (cx / mux_n) ** 2
         qy2 = (cy / muy_n) ** 2
         n_lo = _norm(cx / mmx, cy / mmy)  # trial norm with saturated mu (lower bound of N)
-        lam0, lo, hi = _initial_bracket(ntr, s.p, ax, ay, qx2, qy2, n_lo)
-        p = s.p
+        lam0, lo, hi = _initial_bracket(ntr, s.pressure, ax, ay, qx2, qy2, n_lo)
+        p = s.pressure
 
         def state(lam):
             Dx = 1.0 + lam * ax
             Dy = 1.0 + lam * ay
             tx = cx / Dx
             ty = cy / Dy
-            mux, dmux, muy, dmuy = self._mu(s.kapx + lam * wx * acx / Dx,
-                                            s.kapy + lam * wy * acy / Dy)
+            mux, dmux, muy, dmuy = self._mu(s.kappa_x + lam * wx * acx / Dx,
+                                            s.kappa_y + lam * wy * acy / Dy)
             return Dx, Dy, tx, ty, mux, dmux, muy, dmuy
 
         def model(lam):
@@ -560,10 +657,11 @@ class IsotropicSlipHardening:
 
     def __post_init__(self) -> None:
         s = object.__setattr__
-        s(self, "mu_macro", _scalar("mu_macro", self.mu_macro, 0.0, np.inf, True))
+        s(self, "mu_macro", check_scalar("mu_macro", self.mu_macro, lo=0.0))
         s(self, "mu_initial_ratio",
-          _scalar("mu_initial_ratio", self.mu_initial_ratio, 0.0, 1.0, True, hi_open=False))
-        s(self, "hardening", _scalar("hardening", self.hardening, 0.0, np.inf, False))
+          check_scalar("mu_initial_ratio", self.mu_initial_ratio, lo=0.0, hi=1.0, hi_open=False))
+        s(self, "hardening",
+          check_scalar("hardening", self.hardening, lo=0.0, lo_open=False, unit="1/mm"))
 
     def _mu(self, kap):
         return _hardening(self.mu_macro, self.mu_initial_ratio, self.hardening, kap)
@@ -588,45 +686,70 @@ class IsotropicSlipHardening:
         return _public_result(self, _columns(elastic_slip, kt, dkt, pressure, kn,
                                              accumulated_slip, slip_path))
 
-    def _map(self, c: _Columns, out_t, out_D) -> Optional[_Slip]:
-        mu, _ = self._mu(c.path)
+    def evaluate(self, points: FrictionInput, traction: Optional[np.ndarray] = None,
+                 tangent: Optional[np.ndarray] = None) -> FrictionOutput:
+        """Return map (radial when kTx == kTy) and algorithmic tangent at m points (hot path).
+
+        Pure: ``points`` is read, never written. The results are written into ``traction`` and
+        ``tangent`` when given (e.g. views into the composed law's (n, 3) and (n, 3, 3) arrays,
+        which saves a copy), else into new arrays. Only shapes are checked here; the values are
+        trusted (finite, p >= 0, kT > 0: what the composed law produces from a finite jump);
+        ``return_map`` is the validated entry point for other callers.
+
+        Args:
+            points: the inputs at m points (``FrictionInput``).
+            traction: optional (m, 2) float64 output for (t_x, t_y) [MPa].
+            tangent: optional (m, 2, 3) float64 output for d t_T / d(g, s_x, s_y) [MPa/mm].
+
+        Returns:
+            ``FrictionOutput``: traction and tangent at all m points, and the plastic slip
+            increments at the k slipping points.
+
+        Raises:
+            ValueError: wrong types or shapes. ReturnMappingError (a ``ConvergenceError``): the
+                local Newton did not converge.
+        """
+        out_t, out_D = _outputs(points, traction, tangent)
+        c = points
+        mu, _ = self._mu(c.slip_path)
         tx, ty = _write_stick(c, out_t, out_D)
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-            lim = mu * c.p
+            lim = mu * c.pressure
             qx = tx / lim
             qy = ty / lim
             slipping = qx * qx + qy * qy > 1.0
         if not slipping.any():
-            return None
+            return _no_slip(out_t, out_D)
         idx = np.flatnonzero(slipping)
         s = c.take(idx)
         mu_s = mu if np.isscalar(mu) else mu.take(idx)
         cx, cy = tx.take(idx), ty.take(idx)
         T = _norm(cx, cy)
-        released = T * (_RELEASE * _spread(s.kx, s.ky)) > mu_s * s.p
+        released = T * (_RELEASE * _spread(s.kt_x, s.kt_y)) > mu_s * s.pressure
         dspx = np.empty(idx.size)
         dspy = np.empty(idx.size)
         its = 0
         if released.any():
             r = np.flatnonzero(released)
             sr = s.take(r)
-            mr, _ = self._mu(sr.path + np.hypot(sr.ex, sr.ey))
-            rtx, rty, dspx[r], dspy[r], D = _released(sr, sr.ex, sr.ey, mr, mr)
+            mr, _ = self._mu(sr.slip_path + np.hypot(sr.elastic_slip_x, sr.elastic_slip_y))
+            rtx, rty, dspx[r], dspy[r], D = _released(sr, sr.elastic_slip_x, sr.elastic_slip_y,
+                                                      mr, mr)
             _write_slip(idx[r], out_t, out_D, rtx, rty, D)
         if not released.all():
             g = np.flatnonzero(~released) if released.any() else slice(None)
             sg = s.take(g) if released.any() else s
             pick = (lambda v: v if np.isscalar(v) else v[g])  # noqa: E731
             args = (sg, pick(mu_s), cx[g], cy[g], T[g])
-            radial = np.array_equal(sg.kx, sg.ky) and np.array_equal(sg.dkx, sg.dky)
+            radial = np.array_equal(sg.kt_x, sg.kt_y) and np.array_equal(sg.dkt_x, sg.dkt_y)
             gtx, gty, dspx[g], dspy[g], D, its = (self._radial(*args) if radial
                                                   else self._general(*args))
             _write_slip(idx[g], out_t, out_D, gtx, gty, D)
-        return _Slip(idx, dspx, dspy, its)
+        return FrictionOutput(out_t, out_D, idx, dspx, dspy, _norm(dspx, dspy), its)
 
-    def _radial(self, s: _Columns, mu_n, cx, cy, T):
+    def _radial(self, s: FrictionInput, mu_n, cx, cy, T):
         """kTx == kTy: t = tau m, m = t_trial/|t_trial|, tau = p mu(kappa_n + (T - tau)/k)."""
-        k, dk, p, kap = s.kx, s.dkx, s.p, s.path
+        k, dk, p, kap = s.kt_x, s.dkt_x, s.pressure, s.slip_path
         its = 1
         if self.mu_initial_ratio == 1.0 or self.hardening == 0.0:
             mu, dmu = mu_n, 0.0
@@ -656,22 +779,22 @@ class IsotropicSlipHardening:
         # d t_trial = k ds + dk e dg;  dT = m . d t_trial;  dm = (I - m m) d t_trial / T
         cc = p * dmu / k
         inv = 1.0 / (1.0 + cc)
-        dT_g = dk * (mx * s.ex + my * s.ey)
+        dT_g = dk * (mx * s.elastic_slip_x + my * s.elastic_slip_y)
         dtau_g = (cc * (dT_g - dgam * dk) - mu * s.kn) * inv
         ck = cc * k * inv
         r = tau / T
         rk = r * k
-        px = dk * s.ex - mx * dT_g
-        py = dk * s.ey - my * dT_g
+        px = dk * s.elastic_slip_x - mx * dT_g
+        py = dk * s.elastic_slip_y - my * dT_g
         mxy = mx * my
         D = {(0, 0): dtau_g * mx + r * px, (1, 0): dtau_g * my + r * py,
              (0, 1): ck * mx * mx + rk * (1.0 - mx * mx), (0, 2): (ck - rk) * mxy,
              (1, 1): (ck - rk) * mxy, (1, 2): ck * my * my + rk * (1.0 - my * my)}
         return tau * mx, tau * my, dgam * mx, dgam * my, D, its
 
-    def _general(self, s: _Columns, mu_n, cx, cy, T):
+    def _general(self, s: FrictionInput, mu_n, cx, cy, T):
         """kTx != kTy: t_i = t_trial,i / (1 + lam kT_i), kappa = kappa_n + lam ||t||."""
-        ax, ay, p, kap = s.kx, s.ky, s.p, s.path
+        ax, ay, p, kap = s.kt_x, s.kt_y, s.pressure, s.slip_path
         lam0, lo, hi = _initial_bracket(T / mu_n, p, ax, ay, cx * cx, cy * cy,
                                         T / self.mu_macro)
 

@@ -1,70 +1,79 @@
-"""The composed interface law at quadrature points: (jump, committed state) -> traction, tangent.
+"""The composed rough-interface law at quadrature points: (jump, committed) -> LawResult.
 
 Units: mm, N, MPa. Jumps and separations [mm]; tractions and pressures [MPa]; stiffnesses per
 nominal area [MPa/mm]; dissipation per nominal area [N/mm].
 
-Contract (``/work/notes/common.md``): local axes (n, x, y) per point, n the unit normal of the
-FIRST surface pointing towards the second body, x the grain direction, y = n x x.
-``jump`` (n_pts, 3) = [g, s_x, s_y] = local components of u_second - u_first (g > 0 opens).
-The mean-plane separation is h = h0 + g. The traction is energy-conjugate to the jump,
-t = dpsi/djump: t_N = -p(h) <= 0 and t_T = K_T(h) (s - s_p) limited by friction, with
-K_T = diag(c_x, c_y) kN(h). The tangent is D = dt/djump (n_pts, 3, 3), D[:, 0, 0] = kN(h).
+The law follows the interface-law contract of ``rough_contact.interface.contract`` (local axes
+(n, x, y), jump [g, s_x, s_y] with g > 0 opening, t = dpsi/djump, algorithmic tangent, purity,
+failures). The mean-plane separation is h = h0 + g; t_N = -p(h) <= 0 and t_T = K_T(h) (s - s_p)
+limited by friction, with K_T = diag(c_x, c_y) kN(h); D[:, 0, 0] = kN(h).
+``docs/equations.md`` (section "Interface law") states the paper's equations these readings
+rest on.
 
-Layers: normal law (p, kN, A/A0, dkN/dh) -> tangential stiffness (kT = c kN) -> friction return
-map (only at points with p > 0). Open points (p == 0) carry no traction, have zero tangential
-tangent rows and keep their history.
+Layers: normal law (p, kN, A/A0, dkN/dh; any ``NormalLawProtocol``) -> tangential stiffness
+(kT = c kN) -> friction return map (only at points with p > 0). Open points (p == 0) carry no
+traction, have zero tangential tangent rows and keep their history.
 """
 
 from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
-from typing import Any, Optional, Union
+from typing import Optional, Protocol, Tuple, Union, runtime_checkable
 
 import numpy as np
 
-from .friction import IsotropicSlipHardening, OrthotropicSlipHardening, _Columns, _norm
+from ..validation import check_scalar
+from .contract import LawResult, check_jump
+from .friction import FrictionInput, IsotropicSlipHardening, OrthotropicSlipHardening
 from .state import InterfaceState
 from .tangential import TangentialStiffness
 
-__all__ = ["InterfaceLaw", "LawResult"]
+__all__ = ["InterfaceLaw", "NormalLawProtocol", "SeatableNormalLaw"]
 
 Friction = Union[OrthotropicSlipHardening, IsotropicSlipHardening]
 
 
-@dataclass(frozen=True)
-class LawResult:
-    """Outcome of one law evaluation at n points.
+@runtime_checkable
+class NormalLawProtocol(Protocol):
+    """What ``InterfaceLaw`` needs from a normal law: p, kN, A/A0 (and dkN/dh) vs separation.
 
-    Attributes:
-        traction: (n, 3) [t_N, t_x, t_y] [MPa], t_N = -p.
-        tangent: (n, 3, 3) consistent (algorithmic) tangent dt/djump [MPa/mm], non-symmetric.
-        state: trial InterfaceState (commit it after the global Newton converged).
-        dissipation: (n,) increment t_T . Delta s_p >= 0 [N/mm].
-        area_fraction: (n,) real-area fraction A/A0 [-].
-        contact: (n,) bool, p > 0.
-        slipping: (n,) bool, the friction limit is active.
-        pressure: (n,) contact pressure p [MPa].
+    ``rough_contact.interface.normal.NormalLaw`` (the statistical law) implements it; so can any
+    smooth law of the mean-plane separation h with p -> 0 as h grows. ``with_seating`` needs the
+    inverse as well (:class:`SeatableNormalLaw`); a law used with an explicit ``h0`` does not.
     """
 
-    traction: np.ndarray
-    tangent: np.ndarray
-    state: InterfaceState
-    dissipation: np.ndarray
-    area_fraction: np.ndarray
-    contact: np.ndarray
-    slipping: np.ndarray
-    pressure: np.ndarray
+    def evaluate(self, h: np.ndarray, curvature: bool = False) -> Tuple[np.ndarray, ...]:
+        """Normal law at separations h (n,) [mm].
+
+        Returns:
+            ``(p, k, a)``, or ``(p, k, a, dk_dh)`` if ``curvature``: pressure p >= 0 [MPa],
+            stiffness k = -dp/dh >= 0 [MPa/mm], real-area fraction a = A/A0 in [0, 1] [-] and
+            dk/dh [MPa/mm^2], each (n,) float.
+        """
+        ...
+
+
+@runtime_checkable
+class SeatableNormalLaw(NormalLawProtocol, Protocol):
+    """A normal law with the inverse p -> h, which ``InterfaceLaw.with_seating`` needs."""
+
+    def separation_for_pressure(self, p: np.ndarray) -> np.ndarray:
+        """Separation h (n,) [mm] at which the pressure is p (n,) > 0 [MPa] (inverse of p(h))."""
+        ...
 
 
 @dataclass(frozen=True)
 class InterfaceLaw:
     """Rough-interface law: statistical normal law + Mindlin tangential stiffness + friction.
 
+    Implements ``rough_contact.interface.contract.InterfaceLawProtocol`` with
+    ``InterfaceState`` as history.
+
     Args:
-        normal: normal law with ``evaluate(h, curvature=False) -> (p, k, a)`` and
-            ``evaluate(h, curvature=True) -> (p, k, a, dk_dh)``, and (for ``with_seating``)
-            ``separation_for_pressure(p) -> h`` (``rough_contact.interface.normal.NormalLaw``).
+        normal: the normal law (``NormalLawProtocol``, e.g.
+            ``rough_contact.interface.normal.NormalLaw``; ``with_seating`` needs a
+            ``SeatableNormalLaw``).
         tangential: tangential stiffness ratios kT/kN (needed when ``friction`` is given).
         friction: ``OrthotropicSlipHardening`` or ``IsotropicSlipHardening``; None means
             frictionless (t_T = 0, no history).
@@ -72,14 +81,15 @@ class InterfaceLaw:
             with ``with_seating``.
     """
 
-    normal: Any
+    normal: NormalLawProtocol
     tangential: Optional[TangentialStiffness] = None
     friction: Optional[Friction] = None
     h0: Optional[float] = None
 
     def __post_init__(self) -> None:
-        if not callable(getattr(self.normal, "evaluate", None)):
-            raise ValueError(f"normal = {self.normal!r} must have an evaluate(h, curvature) method")
+        if not isinstance(self.normal, NormalLawProtocol):
+            raise ValueError(f"normal = {self.normal!r} must implement NormalLawProtocol "
+                             "(evaluate(h, curvature))")
         if self.friction is not None:
             if not isinstance(self.friction, (OrthotropicSlipHardening, IsotropicSlipHardening)):
                 raise ValueError(f"friction = {self.friction!r} must be an "
@@ -89,16 +99,20 @@ class InterfaceLaw:
                 raise ValueError("tangential (a TangentialStiffness) is required when friction is "
                                  f"given, got {self.tangential!r}")
         if self.h0 is not None:
-            h0 = float(self.h0)
-            if not np.isfinite(h0):
-                raise ValueError(f"h0 = {self.h0!r} must be finite [mm]")
-            object.__setattr__(self, "h0", h0)
+            object.__setattr__(self, "h0", check_scalar("h0", self.h0, unit="mm"))
 
     def with_seating(self, p_seat: float) -> InterfaceLaw:
-        """Copy whose h0 solves p(h0) = p_seat [MPa] (zero gap carries the seating pressure)."""
-        p = float(p_seat)
-        if not (np.isfinite(p) and p > 0.0):
-            raise ValueError(f"p_seat = {p_seat!r} must be finite and > 0 [MPa]")
+        """Copy whose h0 solves p(h0) = p_seat [MPa] (zero gap carries the seating pressure).
+
+        Raises:
+            ValueError: p_seat not finite and > 0, or a normal law without the inverse
+                (``SeatableNormalLaw``).
+        """
+        p = check_scalar("p_seat", p_seat, lo=0.0, unit="MPa")
+        if not isinstance(self.normal, SeatableNormalLaw):
+            raise ValueError(f"with_seating needs a normal law with separation_for_pressure(p) "
+                             f"(SeatableNormalLaw); {type(self.normal).__name__} has none: give "
+                             "h0 directly")
         h0 = float(np.asarray(self.normal.separation_for_pressure(np.array([p]))).reshape(-1)[0])
         return dataclasses.replace(self, h0=h0)
 
@@ -109,24 +123,26 @@ class InterfaceLaw:
     def evaluate(self, jump: np.ndarray, committed: InterfaceState) -> LawResult:
         """Traction, consistent tangent and trial state at jump (n, 3) [mm]; never mutates input.
 
+        Args:
+            jump: (n, 3) [g, s_x, s_y] [mm].
+            committed: history at the last converged increment (n points).
+
+        Returns:
+            ``LawResult`` with an ``InterfaceState`` trial state and the dissipation increment.
+
         Raises:
-            ValueError: bad shapes, non-finite jumps or h0 not set.
-            rough_contact.interface.friction.ReturnMappingError: local Newton failure.
+            ValueError: bad shapes, a committed state that is not an InterfaceState, h0 not set.
+            rough_contact.interface.contract.ConvergenceError: non-finite jump, or
+                ``ReturnMappingError`` (a subclass) when the local Newton fails.
         """
         if self.h0 is None:
             raise ValueError("h0 (reference separation [mm]) is not set: pass h0= or use "
                              "with_seating(p_seat)")
-        jump = np.asarray(jump, dtype=float)
-        if jump.ndim != 2 or jump.shape[1] != 3:
-            raise ValueError(f"jump must have shape (n_pts, 3), got {jump.shape}")
+        if not isinstance(committed, InterfaceState):
+            raise ValueError(f"committed state must be an InterfaceState, got "
+                             f"{type(committed).__name__}")
+        jump = check_jump(jump, committed)
         n = jump.shape[0]
-        if not isinstance(committed, InterfaceState) or len(committed) != n:
-            got = len(committed) if isinstance(committed, InterfaceState) else type(committed)
-            raise ValueError(f"committed state must be an InterfaceState with {n} points, "
-                             f"got {got}")
-        if not np.isfinite(jump).all():
-            bad = np.flatnonzero(~np.isfinite(jump).all(axis=1))
-            raise ValueError(f"jump is not finite at {bad.size} of {n} points (first {bad[0]})")
 
         h = self.h0 + jump[:, 0]
         traction = np.zeros((n, 3))
@@ -142,39 +158,37 @@ class InterfaceLaw:
         dissipation = np.zeros(n)
         if self.friction is None or not contact.any():
             return LawResult(traction, tangent, committed.copy(), dissipation, a, contact,
-                             slipping, p)
+                             slipping)
 
         cx, cy = self.tangential.kt_over_kn
         sp = committed.plastic_slip
         kap = committed.accumulated_slip
         if contact.all():  # work on views: no gather/scatter
-            cols = _Columns(jump[:, 1] - sp[:, 0], jump[:, 2] - sp[:, 1], cx * k, cy * k,
-                            cx * dk, cy * dk, p, k, kap[:, 0], kap[:, 1], committed.slip_path)
-            slip = self.friction._map(cols, traction[:, 1:], tangent[:, 1:, :])
-            pts = None if slip is None else slip.idx
+            pts_in = FrictionInput(jump[:, 1] - sp[:, 0], jump[:, 2] - sp[:, 1], cx * k, cy * k,
+                                   cx * dk, cy * dk, p, k, kap[:, 0], kap[:, 1],
+                                   committed.slip_path)
+            slip = self.friction.evaluate(pts_in, traction[:, 1:], tangent[:, 1:, :])
+            pts = slip.slip_index
         else:
             ic = np.flatnonzero(contact)
             kc, dkc = k.take(ic), dk.take(ic)
-            cols = _Columns(jump[ic, 1] - sp[ic, 0], jump[ic, 2] - sp[ic, 1], cx * kc, cy * kc,
-                            cx * dkc, cy * dkc, p.take(ic), kc, kap[ic, 0], kap[ic, 1],
-                            committed.slip_path.take(ic))
-            out_t = np.empty((ic.size, 2))
-            out_D = np.empty((ic.size, 2, 3))
-            slip = self.friction._map(cols, out_t, out_D)
-            traction[ic, 1:] = out_t
-            tangent[ic, 1:, :] = out_D
-            pts = None if slip is None else ic.take(slip.idx)
+            pts_in = FrictionInput(jump[ic, 1] - sp[ic, 0], jump[ic, 2] - sp[ic, 1], cx * kc,
+                                   cy * kc, cx * dkc, cy * dkc, p.take(ic), kc, kap[ic, 0],
+                                   kap[ic, 1], committed.slip_path.take(ic))
+            slip = self.friction.evaluate(pts_in)
+            traction[ic, 1:] = slip.traction
+            tangent[ic, 1:, :] = slip.tangent
+            pts = ic.take(slip.slip_index)
 
         state = committed.copy()
-        if slip is not None:
-            dspx, dspy = slip.dspx, slip.dspy
+        if pts.size:
+            dspx, dspy = slip.plastic_increment_x, slip.plastic_increment_y
             dw = traction[pts, 1] * dspx + traction[pts, 2] * dspy
             state.plastic_slip[pts, 0] += dspx
             state.plastic_slip[pts, 1] += dspy
             state.accumulated_slip[pts, 0] += np.abs(dspx)
             state.accumulated_slip[pts, 1] += np.abs(dspy)
-            state.slip_path[pts] += _norm(dspx, dspy)
-            state.dissipated[pts] += dw
+            state.slip_path[pts] += slip.path_increment
             dissipation[pts] = dw
             slipping[pts] = True
-        return LawResult(traction, tangent, state, dissipation, a, contact, slipping, p)
+        return LawResult(traction, tangent, state, dissipation, a, contact, slipping)

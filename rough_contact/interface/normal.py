@@ -3,6 +3,11 @@
 Units: separation h of the mean planes [mm], pressure p = W/A0 [MPa], normal stiffness per unit
 nominal area k = -dp/dh [MPa/mm], its derivative dk/dh [MPa/mm^2], real-area fraction a = A/A0 [-].
 
+:class:`NormalLaw` implements ``rough_contact.interface.law.SeatableNormalLaw``, the part of the
+interface law (``rough_contact.interface.contract``) that maps the separation h = h0 + g to the
+normal traction t_N = -p(h) and its tangent k(h). The population models and the readings of the
+paper's equations behind them are described in ``docs/equations.md``.
+
 The population integrals of :mod:`rough_contact.population` cost far too much to be evaluated at
 every facet quadrature point of every Newton iteration, so :class:`NormalLaw` replaces them by an
 interpolant built once per surface and material:
@@ -58,6 +63,8 @@ from typing import Callable, Optional, Tuple
 
 import numpy as np
 
+from ..validation import check_scalar
+
 __all__ = ["NormalLaw"]
 
 Model = Callable[[np.ndarray], Tuple[np.ndarray, np.ndarray, np.ndarray]]
@@ -73,23 +80,8 @@ _BLOCK = 4096
 # ----------------------------------------------------------------------------------------------
 # validation helpers
 # ----------------------------------------------------------------------------------------------
-def _positive_scalar(name: str, value, allow_zero: bool = False) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a real number, got {value!r}") from None
-    ok = np.isfinite(v) and (v >= 0.0 if allow_zero else v > 0.0)
-    if not ok:
-        rng = "[0, inf)" if allow_zero else "(0, inf)"
-        raise ValueError(f"{name} = {value!r} is outside the valid range {rng}")
-    return v
-
-
 def _check_rtol(rtol) -> float:
-    r = _positive_scalar("rtol", rtol)
-    if not (1e-12 <= r <= 0.1):
-        raise ValueError(f"rtol = {rtol!r} is outside the valid range [1e-12, 0.1]")
-    return r
+    return check_scalar("rtol", rtol, lo=1e-12, hi=0.1, lo_open=False, hi_open=False)
 
 
 def _model_values(model: Model, h: np.ndarray) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -520,13 +512,9 @@ class NormalLaw:
     def _from_population(cls, fn, surface, param, rtol, area_limit, depth, tail, kwargs, name,
                          check):
         rtol = _check_rtol(rtol)
-        area_limit = _positive_scalar("area_limit", area_limit)
-        if area_limit >= 1.0:
-            raise ValueError(f"area_limit = {area_limit!r} is outside the valid range (0, 1)")
-        depth = _positive_scalar("depth", depth, allow_zero=True)
-        tail = _positive_scalar("tail", tail)
-        if tail >= 1e-2:
-            raise ValueError(f"tail = {tail!r} is outside the valid range (0, 1e-2)")
+        area_limit = check_scalar("area_limit", area_limit, lo=0.0, hi=1.0)
+        depth = check_scalar("depth", depth, lo=0.0, lo_open=False)
+        tail = check_scalar("tail", tail, lo=0.0, hi=1e-2)
 
         calls = [0]
 
@@ -607,7 +595,7 @@ class NormalLaw:
         """
         from rough_contact import population
 
-        _positive_scalar("E_star", E_star)
+        check_scalar("E_star", E_star, lo=0.0, unit="MPa")
         return cls._from_population(population.elastic, surface, E_star, rtol, area_limit,
                                     depth, tail, model_kwargs, "elastic", check)
 
@@ -632,14 +620,14 @@ class NormalLaw:
     def greenwood_williamson(cls, surface, E_star: float, rtol: float = 1e-4, *,
                              area_limit: float = 0.3, depth: float = 3.0, tail: float = 1e-12,
                              check: str = "midpoint", **model_kwargs) -> "NormalLaw":
-        """Law of McCool's equivalent Greenwood-Williamson model (see EQUATIONS.md).
+        """Law of McCool's equivalent Greenwood-Williamson model (``docs/equations.md``).
 
         Args: as in :meth:`elastic`; **model_kwargs go to
         :func:`rough_contact.population.greenwood_williamson`.
         """
         from rough_contact import population
 
-        _positive_scalar("E_star", E_star)
+        check_scalar("E_star", E_star, lo=0.0, unit="MPa")
         return cls._from_population(population.greenwood_williamson, surface, E_star, rtol,
                                     area_limit, depth, tail, model_kwargs, "greenwood_williamson",
                                     check)

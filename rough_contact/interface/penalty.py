@@ -1,15 +1,12 @@
-"""Simple penalty interface laws (pure numpy), with the same contract as the rough-surface law.
+"""Simple penalty interface laws (pure numpy), following the same contract as the rough law.
 
 They serve as oracles and stand-ins for the statistical law of ``rough_contact.interface.law``:
-the FE layer (``rough_contact.fem.contact.ContactInterface``) treats every law alike.
+the FE layer (``rough_contact.fem.contact.ContactInterface``) treats every law alike. Both follow
+the interface-law contract of ``rough_contact.interface.contract`` (local axes (n, x, y), jump
+[g, s_x, s_y] with g > 0 opening, t = dpsi/djump so t_N = -p <= 0, D[:, 0, 0] = k = -dp/dg >= 0,
+purity, dissipation increments) and keep their history in ``InterfaceState``.
 
 Units: mm, N, MPa. Jumps [mm]; tractions [MPa]; stiffnesses per area [MPa/mm].
-
-Contract (see ``/work/notes/common.md``): at each point the local axes are (n, x, y), with n the
-unit normal of the FIRST surface pointing towards the second body. ``jump`` (n_pts, 3) holds
-[g, s_x, s_y], the local components of u_second - u_first (g > 0 opens the gap). The traction is
-energy-conjugate to the jump, t = dpsi/djump, so t_N = -p <= 0 in compression, and the tangent
-D = dt/djump has D[:, 0, 0] = k = -dp/dg >= 0.
 """
 
 from __future__ import annotations
@@ -19,76 +16,18 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.special import expit
 
-__all__ = ["LinearPenalty", "SoftplusPenalty", "PenaltyState", "PenaltyResult"]
+from ..validation import check_scalar
+from .contract import LawResult, check_jump
+from .state import InterfaceState
+
+__all__ = ["LinearPenalty", "SoftplusPenalty"]
 
 
-@dataclass
-class PenaltyState:
-    """History at interface points.
-
-    Attributes:
-        plastic_slip: (n_pts, 2) accumulated irreversible slip in local axes (x, y) [mm].
-    """
-
-    plastic_slip: np.ndarray
-
-    def copy(self) -> PenaltyState:
-        return PenaltyState(self.plastic_slip.copy())
-
-    def __len__(self) -> int:
-        return self.plastic_slip.shape[0]
-
-
-@dataclass(frozen=True)
-class PenaltyResult:
-    """Outcome of one law evaluation at n points.
-
-    Attributes:
-        traction: (n, 3) [t_N, t_x, t_y] [MPa], energy-conjugate to the jump.
-        tangent: (n, 3, 3) consistent tangent dt/djump [MPa/mm].
-        state: trial state (not committed).
-        dissipation: (n,) increment t_T . delta(plastic slip) [N/mm].
-        area_fraction: (n,) real-area fraction A/A0 [-] (a toy measure for penalty laws).
-        contact: (n,) bool, p > 0.
-        slipping: (n,) bool, the friction limit is active.
-    """
-
-    traction: np.ndarray
-    tangent: np.ndarray
-    state: PenaltyState
-    dissipation: np.ndarray
-    area_fraction: np.ndarray
-    contact: np.ndarray
-    slipping: np.ndarray
-
-    @property
-    def pressure(self) -> np.ndarray:
-        """(n,) contact pressure p = -t_N [MPa]."""
-        return -self.traction[:, 0]
-
-
-def _check_jump(jump: np.ndarray, committed: PenaltyState) -> np.ndarray:
-    jump = np.asarray(jump, dtype=float)
-    if jump.ndim != 2 or jump.shape[1] != 3:
-        raise ValueError(f"jump must have shape (n_pts, 3), got {jump.shape}")
-    if not np.all(np.isfinite(jump)):
-        bad = np.flatnonzero(~np.all(np.isfinite(jump), axis=1))
-        raise ValueError(
-            f"jump is not finite at {bad.size} of {jump.shape[0]} points (first index {bad[0]})"
-        )
-    if committed.plastic_slip.shape != (jump.shape[0], 2):
-        raise ValueError(
-            f"committed state has {committed.plastic_slip.shape[0]} points, "
-            f"jump has {jump.shape[0]}"
-        )
-    return jump
-
-
-def _positive(name: str, value: float, allow_zero: bool = False) -> None:
-    ok = value >= 0.0 if allow_zero else value > 0.0
-    if not (np.isfinite(value) and ok):
-        bound = ">= 0" if allow_zero else "> 0"
-        raise ValueError(f"{name} = {value!r} must be finite and {bound}")
+def _check_inputs(jump, committed) -> np.ndarray:
+    if not isinstance(committed, InterfaceState):
+        raise ValueError(f"committed state must be an InterfaceState, got "
+                         f"{type(committed).__name__}")
+    return check_jump(jump, committed)
 
 
 @dataclass(frozen=True)
@@ -106,15 +45,20 @@ class LinearPenalty:
     unilateral: bool = False
 
     def __post_init__(self) -> None:
-        _positive("k_normal", self.k_normal)
-        _positive("k_tangential", self.k_tangential, allow_zero=True)
+        check_scalar("k_normal", self.k_normal, lo=0.0, unit="MPa/mm")
+        check_scalar("k_tangential", self.k_tangential, lo=0.0, lo_open=False, unit="MPa/mm")
 
-    def initial_state(self, n_pts: int) -> PenaltyState:
-        return PenaltyState(np.zeros((int(n_pts), 2)))
+    def initial_state(self, n_pts: int) -> InterfaceState:
+        """Virgin history at n_pts points (this law keeps none: the state is carried unchanged)."""
+        return InterfaceState.zeros(n_pts)
 
-    def evaluate(self, jump: np.ndarray, committed: PenaltyState) -> PenaltyResult:
-        """Traction (n, 3) and tangent (n, 3, 3) at jump (n, 3) [mm]; pure (no mutation)."""
-        jump = _check_jump(jump, committed)
+    def evaluate(self, jump: np.ndarray, committed: InterfaceState) -> LawResult:
+        """Traction (n, 3) and tangent (n, 3, 3) at jump (n, 3) [mm]; pure (no mutation).
+
+        Raises:
+            ValueError: wrong shapes. ConvergenceError: non-finite jump.
+        """
+        jump = _check_inputs(jump, committed)
         n = jump.shape[0]
         g = jump[:, 0]
         active = (g <= 0.0) if self.unilateral else np.ones(n, dtype=bool)
@@ -128,7 +72,7 @@ class LinearPenalty:
         tangent[:, 1, 1] = kt
         tangent[:, 2, 2] = kt
         contact = -traction[:, 0] > 0.0
-        return PenaltyResult(
+        return LawResult(
             traction=traction,
             tangent=tangent,
             state=committed.copy(),
@@ -163,22 +107,30 @@ class SoftplusPenalty:
     friction: float = 0.0
 
     def __post_init__(self) -> None:
-        _positive("k_normal", self.k_normal)
-        _positive("width", self.width)
-        _positive("k_tangential", self.k_tangential, allow_zero=True)
-        _positive("friction", self.friction, allow_zero=True)
+        check_scalar("k_normal", self.k_normal, lo=0.0, unit="MPa/mm")
+        check_scalar("width", self.width, lo=0.0, unit="mm")
+        check_scalar("k_tangential", self.k_tangential, lo=0.0, lo_open=False, unit="MPa/mm")
+        check_scalar("friction", self.friction, lo=0.0, lo_open=False)
 
-    def initial_state(self, n_pts: int) -> PenaltyState:
-        return PenaltyState(np.zeros((int(n_pts), 2)))
+    def initial_state(self, n_pts: int) -> InterfaceState:
+        """Virgin history (no plastic slip) at n_pts points."""
+        return InterfaceState.zeros(n_pts)
 
     def normal(self, g: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Pressure p(g) [MPa] and stiffness k = -dp/dg [MPa/mm] at gaps g (n,) [mm]."""
         z = -np.asarray(g, dtype=float) / self.width
         return self.k_normal * self.width * np.logaddexp(0.0, z), self.k_normal * expit(z)
 
-    def evaluate(self, jump: np.ndarray, committed: PenaltyState) -> PenaltyResult:
-        """Traction (n, 3) and tangent (n, 3, 3) at jump (n, 3) [mm]; pure (no mutation)."""
-        jump = _check_jump(jump, committed)
+    def evaluate(self, jump: np.ndarray, committed: InterfaceState) -> LawResult:
+        """Traction (n, 3) and tangent (n, 3, 3) at jump (n, 3) [mm]; pure (no mutation).
+
+        The trial state carries the plastic slip and, for the record, the slip magnitudes
+        (``accumulated_slip``, ``slip_path``); Coulomb friction does not harden.
+
+        Raises:
+            ValueError: wrong shapes. ConvergenceError: non-finite jump.
+        """
+        jump = _check_inputs(jump, committed)
         n = jump.shape[0]
         p, k = self.normal(jump[:, 0])
         traction = np.zeros((n, 3))
@@ -212,8 +164,10 @@ class SoftplusPenalty:
                 tangent[slipping, 1:, 0] = -self.friction * k[slipping][:, None] * m
                 dslip = ((ns - ls) / kt)[:, None] * m
                 state.plastic_slip[slipping] += dslip
+                state.accumulated_slip[slipping] += np.abs(dslip)
+                state.slip_path[slipping] += (ns - ls) / kt
                 dissipation[slipping] = np.einsum("ij,ij->i", traction[slipping, 1:], dslip)
-        return PenaltyResult(
+        return LawResult(
             traction=traction,
             tangent=tangent,
             state=state,

@@ -1,10 +1,11 @@
-"""Per-point history of the interface law: committed and trial arrays.
+"""Per-point history of the interface laws: the state arrays, and committed / trial bookkeeping.
 
 Units: slips in mm, dissipated energy per nominal area in N/mm (= MPa mm).
 
-The trial state is recomputed from the committed one at every law evaluation (the law is a
-pure function); ``StatePair.commit`` runs once per converged load increment and
-``StatePair.revert`` after a failed one, before the cutback.
+The trial state is recomputed from the committed one at every law evaluation (laws are pure
+functions, ``rough_contact.interface.contract``); ``StatePair.commit`` runs once per converged
+load increment and ``StatePair.revert`` after a failed one, before the cutback. Laws report only
+the dissipation increment of a step; ``StatePair`` is where it is summed.
 """
 
 from __future__ import annotations
@@ -13,30 +14,30 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .contract import LawResult, LawState
+
 __all__ = ["InterfaceState", "StatePair"]
 
 
 @dataclass
 class InterfaceState:
-    """History at n interface points (arrays batch-first).
+    """History at n interface points (arrays batch-first); the state of every built-in law.
 
     Attributes:
         plastic_slip: (n, 2) irreversible slip s_p in local axes (x, y) [mm].
-        accumulated_slip: (n, 2) sum of |Delta s_p,x|, |Delta s_p,y| [mm]; hardening variables
-            of the orthotropic law (89)-(90).
+        accumulated_slip: (n, 2) sums of |Delta s_p,x| and |Delta s_p,y| [mm]; hardening
+            variables of the orthotropic law, (89)-(90).
         slip_path: (n,) sum of ||Delta s_p|| [mm]; hardening variable of the isotropic law (119).
-        dissipated: (n,) cumulative frictional dissipation sum t_T . Delta s_p [N/mm].
     """
 
     plastic_slip: np.ndarray
     accumulated_slip: np.ndarray
     slip_path: np.ndarray
-    dissipated: np.ndarray
 
     def __post_init__(self) -> None:
         n = np.shape(self.plastic_slip)[0] if np.ndim(self.plastic_slip) == 2 else -1
         for name, shape in (("plastic_slip", (n, 2)), ("accumulated_slip", (n, 2)),
-                            ("slip_path", (n,)), ("dissipated", (n,))):
+                            ("slip_path", (n,))):
             arr = getattr(self, name)
             if not isinstance(arr, np.ndarray) or arr.shape != shape or n < 0:
                 want = shape if n >= 0 else "(n, 2)"
@@ -48,13 +49,13 @@ class InterfaceState:
         """Virgin state (no slip, no hardening) at n_pts points."""
         n = int(n_pts)
         if n < 0:
-            raise ValueError(f"n_pts = {n_pts!r} must be >= 0")
-        return cls(np.zeros((n, 2)), np.zeros((n, 2)), np.zeros(n), np.zeros(n))
+            raise ValueError(f"n_pts = {n_pts!r} is invalid: it must be >= 0")
+        return cls(np.zeros((n, 2)), np.zeros((n, 2)), np.zeros(n))
 
     def copy(self) -> InterfaceState:
         """Deep copy."""
         return InterfaceState(self.plastic_slip.copy(), self.accumulated_slip.copy(),
-                              self.slip_path.copy(), self.dissipated.copy())
+                              self.slip_path.copy())
 
     def __len__(self) -> int:
         return self.plastic_slip.shape[0]
@@ -64,7 +65,7 @@ class StatePair:
     """Committed and trial history of one interface, and the dissipation accumulated over it.
 
     The one place where history is committed or dropped and where the dissipation increments
-    that laws report are summed (``rough_contact.interface.contract``).
+    that laws report (``LawResult.dissipation``) are summed.
 
     Args:
         committed: the converged state (any ``LawState``); ``trial`` starts as a copy of it.
@@ -75,18 +76,31 @@ class StatePair:
         dissipated: (n,) dissipation per nominal area summed over committed increments [N/mm].
     """
 
-    def __init__(self, committed):
+    def __init__(self, committed: LawState):
+        if not isinstance(committed, LawState):
+            raise ValueError(f"committed ({type(committed).__name__}) must be a LawState "
+                             "(plastic_slip, copy(), __len__)")
         self.committed = committed
         self.trial = committed.copy()
         n = len(committed)
         self.dissipated = np.zeros(n)
         self._pending = np.zeros(n)
 
-    def update(self, result) -> None:
-        """Store the trial state and dissipation increment of a law evaluation (``LawResult``)."""
-        if len(result.state) != len(self.committed):
-            raise ValueError(f"trial state has {len(result.state)} points, committed has "
-                             f"{len(self.committed)}")
+    def update(self, result: LawResult) -> None:
+        """Keep the trial state and dissipation increment of a law evaluation.
+
+        The latest call wins: a line search evaluates several trial points, and only the one the
+        global Newton accepted is committed.
+
+        Raises:
+            ValueError: ``result`` is not a ``LawResult`` or holds another number of points.
+        """
+        if not isinstance(result, LawResult):
+            raise ValueError(f"update expects a LawResult, got {type(result).__name__}")
+        n = len(self.committed)
+        if len(result.state) != n or np.shape(result.dissipation) != (n,):
+            raise ValueError(f"trial state has {len(result.state)} points and dissipation shape "
+                             f"{np.shape(result.dissipation)}; committed has {n} points")
         self.trial = result.state
         self._pending = result.dissipation
 
@@ -97,6 +111,6 @@ class StatePair:
         self._pending = np.zeros_like(self.dissipated)
 
     def revert(self) -> None:
-        """Discard the trial state (after the global Newton failed, before the cutback)."""
+        """Discard the trial state and its dissipation (the global Newton failed; cutback)."""
         self.trial = self.committed.copy()
         self._pending = np.zeros_like(self.dissipated)

@@ -27,6 +27,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.special import elliprd, ellipkm1
 
+from ..validation import check_scalar
+
 __all__ = ["normal_to_tangential_ratio", "TangentialStiffness"]
 
 
@@ -80,10 +82,9 @@ class TangentialStiffness:
         c = np.asarray(self.kt_over_kn, dtype=float)
         if c.shape != (2,):
             raise ValueError(f"kt_over_kn must be a pair (c_x, c_y), got {self.kt_over_kn!r}")
-        for name, v in zip(("kt_over_kn[0] (kTx/kN)", "kt_over_kn[1] (kTy/kN)"), c):
-            if not (np.isfinite(v) and v > 0.0):
-                raise ValueError(f"{name} = {v!r} must be finite and > 0")
-        object.__setattr__(self, "kt_over_kn", (float(c[0]), float(c[1])))
+        object.__setattr__(self, "kt_over_kn", tuple(
+            check_scalar(name, v, lo=0.0)
+            for name, v in zip(("kt_over_kn[0] (kTx/kN)", "kt_over_kn[1] (kTy/kN)"), c)))
 
     @classmethod
     def from_mindlin(cls, axis_ratio_sq: float, nu: float) -> TangentialStiffness:
@@ -96,9 +97,7 @@ class TangentialStiffness:
         Returns:
             TangentialStiffness with c_x = 1/ratio(a_x^2/a_y^2), c_y = 1/ratio(a_y^2/a_x^2).
         """
-        r = float(axis_ratio_sq)
-        if not (np.isfinite(r) and r > 0.0):
-            raise ValueError(f"axis_ratio_sq = {axis_ratio_sq!r} must be finite and > 0")
+        r = check_scalar("axis_ratio_sq", axis_ratio_sq, lo=0.0)
         rx = normal_to_tangential_ratio(r, nu)
         ry = normal_to_tangential_ratio(1.0 / r, nu)
         return cls((1.0 / float(rx), 1.0 / float(ry)))
@@ -117,9 +116,8 @@ class TangentialStiffness:
                 ratio does not depend on the length unit).
             nu: Poisson's ratio of both bodies, in (-1, 0.5] [-].
         """
-        m40, m04 = float(surface.m40), float(surface.m04)
-        if not (np.isfinite(m40) and np.isfinite(m04) and m40 > 0 and m04 > 0):
-            raise ValueError(f"surface moments m40 = {m40!r}, m04 = {m04!r} must be finite and > 0")
+        m40 = check_scalar("surface.m40", surface.m40, lo=0.0)
+        m04 = check_scalar("surface.m04", surface.m04, lo=0.0)
         return cls.from_mindlin(np.sqrt(m04 / m40), nu)
 
     @property

@@ -4,8 +4,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from rough_contact.interface.contract import ConvergenceError, LawResult
 from rough_contact.interface.friction import IsotropicSlipHardening, OrthotropicSlipHardening
-from rough_contact.interface.law import InterfaceLaw, LawResult
+from rough_contact.interface.law import InterfaceLaw
 from rough_contact.interface.state import InterfaceState, StatePair
 from rough_contact.interface.tangential import TangentialStiffness
 
@@ -50,7 +51,7 @@ TS = TangentialStiffness((0.7, 1.0))
 
 def random_state(rng, n, scale=1e-4):
     return InterfaceState(rng.normal(size=(n, 2)) * scale, rng.uniform(0, 5 * scale, (n, 2)),
-                          rng.uniform(0, 5 * scale, n), rng.uniform(0, 1e-3, n))
+                          rng.uniform(0, 5 * scale, n))
 
 
 def test_contract_and_purity():
@@ -62,6 +63,7 @@ def test_contract_and_purity():
     jump = np.column_stack([rng.uniform(-1e-3, 1e-3, n), rng.normal(size=(n, 2)) * 3e-4])
     r = law.evaluate(jump, st)
     assert isinstance(r, LawResult)
+    r.check(n)
     assert r.traction.shape == (n, 3) and r.tangent.shape == (n, 3, 3)
     for arr in (r.dissipation, r.area_fraction, r.contact, r.slipping, r.pressure):
         assert arr.shape == (n,)
@@ -71,14 +73,14 @@ def test_contract_and_purity():
     np.testing.assert_allclose(r.area_fraction, a)
     assert np.all(r.tangent[:, 0, 1:] == 0.0)
     assert r.contact.all() and 20 < r.slipping.sum() < n - 20
-    for name in ("plastic_slip", "accumulated_slip", "slip_path", "dissipated"):
+    for name in ("plastic_slip", "accumulated_slip", "slip_path"):
         np.testing.assert_array_equal(getattr(st, name), getattr(before, name))  # not mutated
     # the trial state carries exactly the increments
     dsp = r.state.plastic_slip - st.plastic_slip
     np.testing.assert_allclose(r.dissipation, np.einsum("ij,ij->i", r.traction[:, 1:], dsp), rtol=1e-12)
     assert np.all(r.dissipation >= 0) and np.all(r.dissipation[~r.slipping] == 0)
     np.testing.assert_allclose(r.state.accumulated_slip - st.accumulated_slip, np.abs(dsp), rtol=1e-12)
-    np.testing.assert_allclose(r.state.dissipated - st.dissipated, r.dissipation, rtol=1e-12, atol=1e-20)
+    np.testing.assert_allclose(r.state.slip_path - st.slip_path, np.hypot(*dsp.T), rtol=1e-12)
     # evaluating twice gives the same answer (pure)
     r2 = law.evaluate(jump, st)
     np.testing.assert_array_equal(r.traction, r2.traction)
@@ -101,7 +103,7 @@ def test_open_points_release_elastic_slip_and_keep_history():
     # close and slide far: plastic slip builds up
     for s in np.linspace(0, 2e-3, 21)[1:]:
         r = law.evaluate(np.array([[0.0, s, 0.5 * s]]), pair.committed)
-        pair.update(r.state)
+        pair.update(r)
         pair.commit()
     sp = pair.committed.plastic_slip.copy()
     kap = pair.committed.accumulated_slip.copy()
@@ -217,12 +219,12 @@ def test_material_point_through_law():
     total = 0.0
     for s in np.linspace(0, 5e-3, 51)[1:]:
         r = law.evaluate(np.array([[-2e-4, s, s]]), pair.committed)
-        pair.update(r.state)
+        pair.update(r)
         pair.commit()
         total += r.dissipation[0]
         mu, _ = ORTHO.coefficients(pair.committed.accumulated_slip)
         assert np.hypot(*(r.traction[0, 1:] / mu[0])) <= r.pressure[0] * (1 + 1e-12)
-    assert pair.committed.dissipated[0] == pytest.approx(total, rel=1e-12)
+    assert pair.dissipated[0] == pytest.approx(total, rel=1e-12)
     assert total > 0
 
 
@@ -233,24 +235,44 @@ def test_empty_rank(friction):
     assert r.traction.shape == (0, 3) and r.tangent.shape == (0, 3, 3) and len(r.state) == 0
 
 
+def _result(state, dissipation):
+    """A LawResult carrying a given trial state and dissipation increment (other fields zero)."""
+    n = len(state)
+    return LawResult(np.zeros((n, 3)), np.zeros((n, 3, 3)), state, np.asarray(dissipation, float),
+                     np.zeros(n), np.zeros(n, bool), np.zeros(n, bool))
+
+
 def test_state_pair_commit_revert():
     pair = StatePair(InterfaceState.zeros(3))
     trial = pair.trial.copy()
     trial.plastic_slip[:] = 1.0
-    pair.update(trial)
-    pair.revert()
+    pair.update(_result(trial, [1.0, 2.0, 3.0]))
+    pair.revert()  # drops the trial state AND its dissipation
     assert np.all(pair.trial.plastic_slip == 0)
-    pair.update(trial)
     pair.commit()
+    np.testing.assert_array_equal(pair.dissipated, 0.0)
+    assert np.all(pair.committed.plastic_slip == 0)
+    pair.update(_result(trial, [1.0, 2.0, 3.0]))
+    pair.update(_result(trial, [0.5, 0.0, 0.25]))  # a line search: the last evaluation counts
+    np.testing.assert_array_equal(pair.dissipated, 0.0)  # nothing before commit
+    pair.commit()
+    np.testing.assert_array_equal(pair.dissipated, [0.5, 0.0, 0.25])
     assert np.all(pair.committed.plastic_slip == 1.0)
     pair.committed.plastic_slip[0] = 7.0  # commit made a copy
     assert trial.plastic_slip[0, 0] == 1.0
+    pair.commit()  # a second commit without a new evaluation adds nothing
+    np.testing.assert_array_equal(pair.dissipated, [0.5, 0.0, 0.25])
+    pair.update(_result(trial, [1.0, 1.0, 1.0]))
+    pair.commit()
+    np.testing.assert_array_equal(pair.dissipated, [1.5, 1.0, 1.25])
     with pytest.raises(ValueError, match="points"):
-        pair.update(InterfaceState.zeros(4))
+        pair.update(_result(InterfaceState.zeros(4), np.zeros(4)))
+    with pytest.raises(ValueError, match="LawResult"):
+        pair.update(InterfaceState.zeros(3))
     with pytest.raises(ValueError, match="plastic_slip"):
-        InterfaceState(np.zeros(3), np.zeros((3, 2)), np.zeros(3), np.zeros(3))
+        InterfaceState(np.zeros(3), np.zeros((3, 2)), np.zeros(3))
     with pytest.raises(ValueError, match="slip_path"):
-        InterfaceState(np.zeros((3, 2)), np.zeros((3, 2)), np.zeros(2), np.zeros(3))
+        InterfaceState(np.zeros((3, 2)), np.zeros((3, 2)), np.zeros(2))
 
 
 def test_bad_law_input():
@@ -258,7 +280,7 @@ def test_bad_law_input():
     st = law.initial_state(2)
     with pytest.raises(ValueError, match="jump"):
         law.evaluate(np.zeros((2, 2)), st)
-    with pytest.raises(ValueError, match="jump"):
+    with pytest.raises(ConvergenceError, match=r"jump is not finite at 1 of 2 points \(first index 0\)"):
         law.evaluate(np.array([[0.0, np.nan, 0.0], [0, 0, 0]]), st)
     with pytest.raises(ValueError, match="committed"):
         law.evaluate(np.zeros((3, 3)), st)
@@ -274,5 +296,12 @@ def test_bad_law_input():
         InterfaceLaw(object(), TS, ORTHO, h0=0.0)
     with pytest.raises(ValueError, match="p_seat"):
         law.with_seating(-1.0)
+
+    class NoInverse:  # a normal law without p -> h: fine with h0, not with with_seating
+        evaluate = ExponentialNormal().evaluate
+
+    assert InterfaceLaw(NoInverse(), TS, ORTHO, h0=1e-3).evaluate(np.zeros((2, 3)), st).contact.all()
+    with pytest.raises(ValueError, match="separation_for_pressure"):
+        InterfaceLaw(NoInverse(), TS, ORTHO).with_seating(1.0)
     with pytest.raises(ValueError, match="n_pts"):
         law.initial_state(-1)

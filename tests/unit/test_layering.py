@@ -8,7 +8,8 @@ import sys
 import rough_contact
 import rough_contact.interface
 
-PURE = ["rough_contact.surface", "rough_contact.asperity", "rough_contact.population"] + [
+PURE = ["rough_contact.surface", "rough_contact.asperity", "rough_contact.population",
+        "rough_contact.validation"] + [
     f"rough_contact.interface.{m.name}" for m in pkgutil.iter_modules(rough_contact.interface.__path__)
 ]
 

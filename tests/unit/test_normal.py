@@ -15,7 +15,7 @@ from scipy.special import gamma, pbdv
 from rough_contact.interface.normal import NormalLaw
 
 # ----------------------------------------------------------------------------------------------
-# An independent Greenwood-Williamson law (McCool's equivalent model, EQUATIONS.md), mm/MPa.
+# An independent Greenwood-Williamson law (McCool's equivalent model, docs/equations.md), mm/MPa.
 # F_nu(d) = int_d^inf (z - d)^nu phi(z) dz = Gamma(nu+1)/sqrt(2 pi) e^{-d^2/4} D_{-nu-1}(d).
 # ----------------------------------------------------------------------------------------------
 

@@ -5,7 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rough_contact.interface.penalty import LinearPenalty, PenaltyState, SoftplusPenalty
+from rough_contact.interface.contract import ConvergenceError
+from rough_contact.interface.penalty import LinearPenalty, SoftplusPenalty
+from rough_contact.interface.state import InterfaceState
 
 
 def fd_tangent(law, jump, committed, h=1e-7):
@@ -21,6 +23,7 @@ def fd_tangent(law, jump, committed, h=1e-7):
 
 
 def check_contract(res, n):
+    res.check(n)
     assert res.traction.shape == (n, 3)
     assert res.tangent.shape == (n, 3, 3)
     assert res.dissipation.shape == (n,)
@@ -69,7 +72,7 @@ def test_softplus_friction_tangent_fd(slip):
     jump = np.column_stack(
         [rng.uniform(-3e-3, 1e-3, n), rng.uniform(-1, 1, (n, 2)) * (1e-3 if slip else 1e-6)]
     )
-    committed = PenaltyState(rng.uniform(-1, 1, (n, 2)) * 1e-7)
+    committed = InterfaceState(rng.uniform(-1, 1, (n, 2)) * 1e-7, np.zeros((n, 2)), np.zeros(n))
     res = law.evaluate(jump, committed)
     check_contract(res, n)
     if slip:
@@ -101,6 +104,10 @@ def test_softplus_return_map_consistency_and_purity():
         res.traction[:, 1:], 5e3 * (jump[:, 1:] - res.state.plastic_slip), rtol=1e-10, atol=1e-12
     )
     assert np.all(res.dissipation >= 0) and np.all(res.dissipation[s] > 0)
+    # the trial state records the slip magnitudes of the step
+    dsp = res.state.plastic_slip - committed.plastic_slip
+    np.testing.assert_allclose(res.state.accumulated_slip, np.abs(dsp), rtol=1e-12)
+    np.testing.assert_allclose(res.state.slip_path, np.hypot(*dsp.T), rtol=1e-12)
     # re-evaluating from the trial state at the same jump is elastic (nothing more slips)
     again = law.evaluate(jump, res.state)
     assert not again.slipping.any()
@@ -118,5 +125,8 @@ def test_bad_input():
     law = LinearPenalty(k_normal=1.0)
     with pytest.raises(ValueError, match="shape"):
         law.evaluate(np.zeros((3, 2)), law.initial_state(3))
-    with pytest.raises(ValueError, match="not finite"):
-        law.evaluate(np.array([[np.nan, 0, 0]]), law.initial_state(1))
+    with pytest.raises(ValueError, match="committed"):
+        law.evaluate(np.zeros((3, 3)), law.initial_state(2))
+    # a non-finite jump is a diverging global iterate: a convergence failure (cutback)
+    with pytest.raises(ConvergenceError, match=r"not finite at 1 of 2 points \(first index 1\)"):
+        law.evaluate(np.array([[0.0, 0, 0], [np.nan, 0, 0]]), law.initial_state(2))

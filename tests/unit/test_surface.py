@@ -72,7 +72,7 @@ def test_summit_density_closed_form_equals_integral_16(moments):
     mu, b1, b2 = s.mu, s.beta1, s.beta2
     X = W1**2 + (1 - b2) * W4**2 + (1 - b1) * W6**2 - 2 * math.sqrt(b1) * W1 * W4 \
         - 2 * math.sqrt(b2) * W1 * W6 + 2 * math.sqrt(b1 * b2) * W4 * W6
-    # the quadratic form above is X of EQUATIONS.md written out (x-direction pairs w1 with w4)
+    # the quadratic form above is X of docs/equations.md written out (x-direction pairs w1 with w4)
     p14 = mu**2 / (2 * math.pi) ** 2.5 * math.sqrt(s.m04 * s.m40 / (s.m02 * s.m20)) \
         * W4 * W6 * np.exp(-X / 2)
     assert np.sum(p14 * wt) == pytest.approx(s.summit_density, rel=1e-9)
