@@ -769,16 +769,13 @@ def _check_arguments(V, law, first_tag, second_tag, rigid_plane, quadrature_degr
     return grain, int(degree)
 
 
-_STRICT_RESULT_TYPE = False
-
-
 def _check_result(law, res, n: int) -> None:
     """The full contract check of a law's result (done on the first evaluation)."""
-    if _STRICT_RESULT_TYPE and not isinstance(res, LawResult):  # TEMP until the contract merge
+    if not isinstance(res, LawResult):
         raise LawContractError(
             f"{type(law).__name__}.evaluate returned {type(res).__name__}; the contract needs "
             "rough_contact.interface.contract.LawResult")
-    LawResult.check(res, n)
+    res.check(n)
 
 
 def _facet_connectivity(msh) -> int:

@@ -9,6 +9,7 @@ Units: mm, N, MPa.
 from __future__ import annotations
 
 import dataclasses
+import types
 
 import numpy as np
 import pytest
@@ -18,6 +19,7 @@ from dolfinx import fem
 from rough_contact.fem.collective import raise_on_all_ranks
 from rough_contact.fem.contact import ContactInterface
 from rough_contact.interface.contract import ConvergenceError, LawContractError
+from rough_contact.interface.friction import ReturnMappingError
 from rough_contact.interface.penalty import LinearPenalty, SoftplusPenalty
 from test_contact import (LOWER_TOP, UPPER_BOTTOM, interpolate_bodies, smooth_field,  # noqa: E402
                           two_blocks)
@@ -95,6 +97,21 @@ def test_first_result_is_checked_naming_the_field(field, make, message):
     assert law.calls == 1
 
 
+class _WrongResultType(_Counting):
+    def evaluate(self, jump, committed):
+        res = super().evaluate(jump, committed)
+        return types.SimpleNamespace(**{f.name: getattr(res, f.name)
+                                        for f in dataclasses.fields(res)})
+
+
+def test_result_must_be_the_contract_law_result():
+    """A look-alike with the same fields is not accepted: the contract has ONE LawResult."""
+    V, ci = _interface(_WrongResultType(LinearPenalty(1e3)))
+    with pytest.raises(LawContractError, match="returned SimpleNamespace; the contract needs "
+                                               "rough_contact.interface.contract.LawResult"):
+        ci.evaluate(fem.Function(V))
+
+
 def test_only_the_first_result_is_checked_in_full():
     """Later evaluations cost no contract check: a law that breaks the contract only after its
     first (valid) result is not caught, as documented (finiteness is still checked)."""
@@ -163,8 +180,8 @@ class _RaisesOnOneRank:
 @pytest.mark.parametrize("kind", ["convergence", "fatal"])
 def test_law_error_on_one_rank_raises_on_every_rank(kind):
     comm = MPI.COMM_WORLD
-    make = (lambda: LocalNewtonError("local Newton failed at 3 points")) if kind == "convergence" \
-        else (lambda: TypeError("unsupported operand"))
+    make = (lambda: ReturnMappingError("local Newton failed at 3 points")) \
+        if kind == "convergence" else (lambda: TypeError("unsupported operand"))
     law = _RaisesOnOneRank(make)
     V, ci = _interface(law)
     with pytest.raises(Exception) as info:
@@ -173,8 +190,8 @@ def test_law_error_on_one_rank_raises_on_every_rank(kind):
         assert info.value is law.raised  # the very object, with its traceback
         assert any(tb.name == "evaluate" for tb in info.traceback)
     elif kind == "convergence":
-        assert type(info.value) is LocalNewtonError
-        assert str(info.value) == f"rank {law.rank} raised LocalNewtonError: local Newton " \
+        assert type(info.value) is ReturnMappingError
+        assert str(info.value) == f"rank {law.rank} raised ReturnMappingError: local Newton " \
                                   "failed at 3 points"
     else:
         assert type(info.value) is RuntimeError

@@ -102,6 +102,7 @@ def test_bad_input_raises():
 from rough_contact.scenes.meshes.blocks import two_blocks  # noqa: E402
 from rough_contact.fem.contact import ContactInterface  # noqa: E402
 from rough_contact.interface.contract import ConvergenceError  # noqa: E402
+from rough_contact.interface.friction import ReturnMappingError  # noqa: E402
 from rough_contact.interface.penalty import LinearPenalty  # noqa: E402
 from rough_contact.solver.loading import LoadStepError, load_path  # noqa: E402
 
@@ -394,7 +395,7 @@ def test_programming_error_in_law_propagates_at_once(where):
     solver.destroy()
 
 
-@pytest.mark.parametrize("error", [LocalNewtonError])
+@pytest.mark.parametrize("error", [ReturnMappingError, LocalNewtonError])
 def test_convergence_error_on_one_rank_cuts_back_on_every_rank(error):
     """A ConvergenceError raised on ONE rank (the first that owns interface points) makes every
     rank cut back together; the load path still reaches the exact answer."""
