@@ -94,7 +94,7 @@ def test_moments_of_a_synthetic_512_map_within_1_percent(table1_psd, table1_map)
     ref = table1_psd.moments().as_um()
     for name in NAMES:
         # m00 misses only the power of the k = 0 bin (the mean of a finite map is unknowable):
-        # Phi(0) (2 pi/L)^2 = 0.35 % of m00 here
+        # Phi(0) (2 pi/L)^2 = 0.36 % of m00 here
         assert abs(est[name] - ref[name]) <= 0.01 * _scale(ref, name), (name, est[name], ref[name])
     assert est["m00"] == pytest.approx(ref["m00"] - table1_psd(0.0, 0.0) * (2 * np.pi / 1024) ** 2,
                                        rel=1e-6)
