@@ -31,8 +31,9 @@ interpolant built once per surface and material:
   quadrature error exceeds rtol/2 there: the table cannot match both the model's k and the slope
   of its p, since its k is the exact slope of its p), so refining it further is useless; (ii) the
   budget: ``max_knots`` and ``max_seconds`` (wall time; a round that the measured cost per model
-  evaluation says would overrun it is not started). Models that converge never meet (i): the
-  tables of non-degenerate surfaces are bit-identical to those built without the detector.
+  evaluation says would overrun it is not started). The detector leaves converging builds
+  alone: the tables of 8 non-degenerate population laws (Tables 1-2, the beam's surfaces, GW,
+  elastic, elasto-plastic) are bit-identical to those built without it.
 * **Taper** ``h_table_end < h < h_max``: ``p = P (1 - t)^3``, ``t = (h - h_table_end)/L`` with
   ``L = 3 P/K`` where P, K are the table's end values; this is the cubic Hermite curve from
   (P, slope -K) to (0, slope 0), monotone, C1 at both ends (and C2 at ``h_max``). The model's
@@ -239,12 +240,14 @@ class TableAccuracyError(ValueError):
             intervals, per quantity: ``{"pressure": .., "stiffness": .., "area_fraction": ..}``.
         h_range: ``(h_a, h_b)`` [mm], the span of the failing intervals.
         model_consistency: largest ``|k_model - (-dp_model/dh)| / k_model`` measured on the
-            failing intervals (central difference of the model's own pressure over the
-            interval; None when not measured): how far the model's stiffness is from the
-            derivative of its pressure.
+            failing intervals (the model's mid-interval stiffness against the central
+            difference of its own pressure over the interval): how far the model's stiffness is
+            from the derivative of its pressure.
         knots: number of knots when the build stopped.
         seconds: wall time of the build when it stopped [s].
         advice: what to change, as a sentence.
+        length_scale: ``(name, value in mm)`` in which the message also shows h (e.g.
+            ``("sqrt(m00)", rq)``), or None.
     """
 
     def __init__(self, reason: str, rtol: float, reached: dict, h_range: Tuple[float, float],
@@ -260,6 +263,14 @@ class TableAccuracyError(ValueError):
         self.advice = advice
         self.length_scale = length_scale
         super().__init__(self._message())
+
+    def _fields(self) -> tuple:
+        return (self.reason, self.rtol, self.reached, self.h_range, self.model_consistency,
+                self.knots, self.seconds, self.advice, self.length_scale)
+
+    def __reduce__(self):
+        # picklable (e.g. sent between processes): rebuilt from its fields, not the message
+        return (type(self), self._fields())
 
     def with_advice(self, advice: str, length_scale: Optional[Tuple[str, float]] = None,
                     seconds: Optional[float] = None) -> "TableAccuracyError":

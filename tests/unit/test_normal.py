@@ -6,6 +6,7 @@ Greenwood-Williamson integrals, central finite differences, analytic laws.
 from __future__ import annotations
 
 import importlib.util
+import pickle
 import time
 
 import numpy as np
@@ -475,6 +476,8 @@ def test_inconsistent_model_stops_as_model_limited_with_the_analytic_figures():
                  "h in [", "derivative of its own pressure", "no rtol in the valid range"):
         assert part in msg, (part, msg)
     assert isinstance(e, ValueError)          # callers catching ValueError keep working
+    again = pickle.loads(pickle.dumps(e))     # e.g. sent between processes
+    assert str(again) == msg and again.reached == e.reached
 
 
 def test_noisy_model_stops_and_the_advised_rtol_then_succeeds():
