@@ -14,11 +14,12 @@ cd "$here"
 DEB_PACKAGES=(python3-dolfinx python3-gmsh python3-scipy python3-pytest python3-matplotlib
               python3-h5py python3-venv python3-wheel libopenblas0-pthread openmpi-bin)
 VENV="$here/.venv"
-TEST_EXTRAS=""
+TEST_EXTRAS="topography"
 PY="$VENV/bin/python"
 
 setup() {
     local missing=()
+    local extras="${RC_EXTRAS:-}"
     for p in "${DEB_PACKAGES[@]}"; do
         dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
     done
@@ -41,13 +42,18 @@ import numpy, scipy
 print(f"numpy=={numpy.__version__}\nscipy=={scipy.__version__}")
 PYEOF
     mv "$cons.new" "$cons"
-    local extras="${RC_EXTRAS:-}"
     local target="."
     [ -z "$extras" ] || target=".[$extras]"
     local stamp="$VENV/.installed${extras:+-${extras//,/-}}"
     if [ ! -f "$stamp" ] || [ pyproject.toml -nt "$stamp" ]; then
         echo "[setup] pip install -e $target (constraints: $(tr '\n' ' ' < "$cons"))"
         "$PY" -m pip install -q --no-build-isolation -c "$cons" -e "$target"
+        # SurfaceTopography (extra "topography") pulls the PyPI h5py wheel, which bundles an HDF5
+        # other than dolfinx's and fails ("Not a datatype") when imported after dolfinx: keep
+        # Debian's python3-h5py (in DEB_PACKAGES) and remove the wheel from the venv.
+        if [[ ",$extras," == *",topography,"* ]] && "$PY" -m pip show -q h5py 2>/dev/null; then
+            "$PY" -m pip uninstall -y -q h5py
+        fi
         touch "$stamp"
     fi
 }

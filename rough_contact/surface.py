@@ -26,12 +26,14 @@ from __future__ import annotations
 import math
 import warnings
 from dataclasses import dataclass, field
+from typing import Tuple
 
 import numpy as np
 
 from .validation import check_scalar
 
-__all__ = ["SpectralMoments", "moments_from_height_map", "psum", "plasticity_index"]
+__all__ = ["SpectralMoments", "moments_from_height_map", "psum", "plasticity_index", "MomentTensor",
+           "moment_tensor_from_height_map", "MOMENT_ORDERS", "WINDOWS"]
 
 _UNIT_SCALE = {"um": 1.0e-3, "mm": 1.0, "m": 1.0e3}  # length unit -> mm
 
@@ -208,6 +210,23 @@ def psum(w1, w4, w6, beta1: float, beta2: float):
     return np.where((w4 > 0) & (w6 > 0), out, 0.0)
 
 
+def _wavenumbers(n: int, d: float) -> np.ndarray:
+    """Angular wavenumbers of an n-point FFT with step d; the Nyquist bin (n even) is set to 0:
+    the derivative of a real signal there is ambiguous."""
+    k = 2 * np.pi * np.fft.fftfreq(n, d=d)
+    if n % 2 == 0:
+        k[n // 2] = 0.0
+    return k
+
+
+def _power_spectrum(z: np.ndarray, dx: float, dy: float):
+    """Discrete PSD P (nx, ny), normalised so that sum P = <z^2> (Parseval), and the angular
+    wavenumbers kx (nx, 1), ky (1, ny) of a periodic map z (nx, ny), axis 0 along x."""
+    nx, ny = z.shape
+    P = np.abs(np.fft.fft2(z)) ** 2 / (nx * ny) ** 2
+    return P, _wavenumbers(nx, dx)[:, None], _wavenumbers(ny, dy)[None, :]
+
+
 def moments_from_height_map(z, dx: float, dy: float | None = None, method: str = "fft",
                             unit: str = "um") -> SpectralMoments:
     """Spectral moments m00, m20, m02, m40, m04 of a sampled, periodic height map.
@@ -240,14 +259,7 @@ def moments_from_height_map(z, dx: float, dy: float | None = None, method: str =
     z = z - z.mean()
     nx, ny = z.shape
     if method == "fft":
-        Z = np.fft.fft2(z)
-        kx = 2 * np.pi * np.fft.fftfreq(nx, d=dx)[:, None]
-        ky = 2 * np.pi * np.fft.fftfreq(ny, d=dy)[None, :]
-        if nx % 2 == 0:  # Nyquist column: derivative of a real signal there is ambiguous
-            kx = kx.copy(); kx[nx // 2] = 0.0
-        if ny % 2 == 0:
-            ky = ky.copy(); ky[:, ny // 2] = 0.0
-        P = np.abs(Z) ** 2 / (nx * ny) ** 2  # Parseval: sum P = <z^2>
+        P, kx, ky = _power_spectrum(z, dx, dy)
         m00 = P.sum()
         m20 = (P * kx**2).sum()
         m02 = (P * ky**2).sum()
@@ -264,3 +276,202 @@ def moments_from_height_map(z, dx: float, dy: float | None = None, method: str =
     else:
         raise ValueError(f"method = {method!r} is invalid: valid methods are 'fft' and 'fd'")
     return SpectralMoments(m00, m20, m02, m40, m04, unit=unit)
+
+
+# ---------------------------------------------------------------------------------------------
+# Moments in arbitrary axes: the mixed moments, rotation to the principal (grain) axes, windows
+# ---------------------------------------------------------------------------------------------
+# (p, q) of every moment m_pq = integral Phi kx^p ky^q of orders 0, 2 and 4 (odd orders vanish
+# for a real surface: Phi(k) = Phi(-k)).
+MOMENT_ORDERS = ((0, 0), (2, 0), (1, 1), (0, 2), (4, 0), (3, 1), (2, 2), (1, 3), (0, 4))
+_MOMENT_NAMES = tuple(f"m{p}{q}" for p, q in MOMENT_ORDERS)
+WINDOWS = ("none", "hann")
+
+
+@dataclass(frozen=True)
+class MomentTensor:
+    """Spectral moments of orders 0, 2 and 4 of a surface in arbitrary in-plane axes (x, y).
+
+    ``m_pq = integral Phi(kx, ky) kx^p ky^q dkx dky`` over angular wavenumbers (the convention of
+    the module docstring and Appendix A): ``m20, m11, m02`` form the slope covariance
+    (``<zx^2>, <zx zy>, <zy^2>``), ``m40 ... m04`` the curvature moments
+    (``m40 = <zxx^2>, m31 = <zxx zxy>, m22 = <zxy^2> = <zxx zyy>, m13 = <zyy zxy>,
+    m04 = <zyy^2>``). Unlike :class:`SpectralMoments` (principal axes, x along the grain, the
+    paper's five moments) the axes here are any, e.g. the pixel axes of a measured map;
+    :meth:`principal` rotates to the grain axes.
+
+    Args:
+        m00: height variance [unit^2], > 0.
+        m20, m11, m02: slope moments [-]; m20, m02 > 0, m11^2 < m20 m02.
+        m40, m31, m22, m13, m04: curvature moments [unit^-2]; m40, m22, m04 > 0.
+        unit: length unit of the given moments, "um" (default), "mm" or "m"; stored in mm.
+    """
+
+    m00: float
+    m20: float
+    m11: float
+    m02: float
+    m40: float
+    m31: float
+    m22: float
+    m13: float
+    m04: float
+    unit: str = "um"
+
+    def __post_init__(self):
+        if self.unit not in _UNIT_SCALE:
+            raise ValueError(f"unit = {self.unit!r} is invalid: valid units are {sorted(_UNIT_SCALE)}")
+        L = _UNIT_SCALE[self.unit]
+        for name, (p, q) in zip(_MOMENT_NAMES, MOMENT_ORDERS):
+            v = float(getattr(self, name))
+            if not math.isfinite(v):
+                raise ValueError(f"{name} = {v!r} is invalid: it must be finite")
+            if p % 2 == 0 and q % 2 == 0 and not v > 0.0:
+                raise ValueError(f"{name} = {v!r} is invalid: it must be > 0")
+            object.__setattr__(self, name, v * L ** (2 - p - q))
+        object.__setattr__(self, "unit", "mm")
+        if not self.m11 ** 2 < self.m20 * self.m02:
+            raise ValueError(f"m11 = {self.m11!r} is invalid: the slope covariance needs "
+                             f"m11^2 < m20 m02 = {self.m20 * self.m02!r}")
+
+    def as_um(self) -> dict:
+        """The moments in the paper's micrometre convention (dict)."""
+        return {n: getattr(self, n) * 1e3 ** (2 - p - q)
+                for n, (p, q) in zip(_MOMENT_NAMES, MOMENT_ORDERS)}
+
+    def rotated(self, angle: float) -> "MomentTensor":
+        """The moments in axes (x', y') turned by ``angle`` [rad] counter-clockwise from (x, y).
+
+        With kx' = c kx + s ky, ky' = -s kx + c ky (c = cos angle, s = sin angle),
+        m'_pq = integral Phi (c kx + s ky)^p (-s kx + c ky)^q: the binomial expansion of the
+        form of order p + q, evaluated with numpy polynomials in t = kx/ky.
+        """
+        c, s_ = math.cos(angle), math.sin(angle)
+        P = np.polynomial.polynomial
+        new = {}
+        for name, (p, q) in zip(_MOMENT_NAMES, MOMENT_ORDERS):
+            n = p + q
+            # coefficient a of t^a multiplies kx^a ky^(n-a), i.e. the moment m_{a, n-a}
+            coef = P.polymul(P.polypow([s_, c], p), P.polypow([c, -s_], q))
+            coef = np.pad(coef, (0, n + 1 - coef.size))
+            new[name] = sum(float(coef[a]) * getattr(self, f"m{a}{n - a}")
+                            for a in range(n + 1) if f"m{a}{n - a}" in _MOMENT_NAMES)
+        return MomentTensor(**new, unit="mm")
+
+    def grain_angle(self) -> float:
+        """Direction of the smallest mean-square slope [rad], in (-pi/2, pi/2], from x towards y.
+
+        The principal axes of the slope covariance (m11' = 0, Longuet-Higgins): m20'(theta) =
+        (m20 + m02)/2 + R cos(2 theta - phi), phi = atan2(2 m11, m20 - m02); its minimum is at
+        phi/2 + pi/2. Along the grain (the paper's x, e.g. the grinding direction) slopes and
+        curvatures are smallest.
+        """
+        phi = math.atan2(2.0 * self.m11, self.m20 - self.m02)
+        return _wrap_half_turn(0.5 * phi + 0.5 * math.pi)
+
+    def curvature_grain_angle(self) -> float:
+        """Direction of the smallest mean-square curvature m40'(theta) [rad], in (-pi/2, pi/2].
+
+        For an orthotropic surface (m11 = m31 = m13 = 0 in its principal axes, the assumption of
+        the strongly anisotropic model) it equals :meth:`grain_angle`; the difference measures
+        how far the surface is from that assumption.
+        """
+        # m40'(theta) is a trigonometric polynomial of degree 4: a fine grid, then one parabolic
+        # refinement (error ~1e-7 rad)
+        th = np.linspace(-0.5 * math.pi, 0.5 * math.pi, 3601)
+        c, s_ = np.cos(th), np.sin(th)
+        f = (c**4 * self.m40 + 4 * c**3 * s_ * self.m31 + 6 * c**2 * s_**2 * self.m22
+             + 4 * c * s_**3 * self.m13 + s_**4 * self.m04)
+        i = int(np.argmin(f[:-1]))
+        fm, f0, fp = f[i - 1], f[i], f[i + 1]   # i - 1 = -1 wraps to the same angle + pi
+        den = fm - 2 * f0 + fp
+        shift = 0.5 * (fm - fp) / den if den > 0 else 0.0
+        return _wrap_half_turn(float(th[i] + shift * (th[1] - th[0])))
+
+    def principal(self) -> Tuple["MomentTensor", float]:
+        """The moments in the grain axes (x' along :meth:`grain_angle`) and that angle [rad]."""
+        angle = self.grain_angle()
+        return self.rotated(angle), angle
+
+    def spectral_moments(self) -> "SpectralMoments":
+        """The paper's five moments in THESE axes (x = grain if this tensor is principal).
+
+        The mixed moments m11, m31, m13 are dropped: the model assumes them zero.
+        SpectralMoments warns below m04/m40 = ANISOTROPY_WARN_RATIO.
+        """
+        return SpectralMoments(self.m00, self.m20, self.m02, self.m40, self.m04, unit="mm")
+
+
+def _wrap_half_turn(angle: float) -> float:
+    """An axis direction [rad] in (-pi/2, pi/2]."""
+    a = math.remainder(angle, math.pi)
+    return a + math.pi if a <= -0.5 * math.pi else a
+
+
+def _window_1d(n: int, window: str) -> np.ndarray:
+    if window == "none":
+        return np.ones(n)
+    if window == "hann":
+        # periodic Hann, sin^2(pi j/n): three DFT bins only, so the correction below is exact
+        return np.sin(np.pi * np.arange(n) / n) ** 2
+    raise ValueError(f"window = {window!r} is invalid: valid windows are {list(WINDOWS)}")
+
+
+def moment_tensor_from_height_map(z, dx: float, dy: float | None = None, unit: str = "um",
+                                  window: str = "none") -> MomentTensor:
+    """All moments of orders 0, 2, 4 (incl. m11, m31, m22, m13) of a sampled height map (FFT).
+
+    Same convention and layout as :func:`moments_from_height_map` (method "fft"): the mean is
+    removed, z has axis 0 along x, spectral derivatives with the Nyquist bin set to zero.
+
+    Window correction (``window="hann"``, for maps that are not periodic, e.g. measured ones:
+    the periodic extension of a non-periodic map jumps at its edges, which adds spurious
+    high-wavenumber power and biases m20 ... m04 upwards). The windowed map w z, with w the
+    separable periodic Hann window, has the expected discrete spectrum
+    ``E|W*Z|^2 = |W|^2 (*) E|Z|^2`` (circular convolution), so its moments, normalised by
+    ``<w^2>`` (the power of the window, 9/64 in 2D), are
+    ``M_pq = sum_{a<=p, b<=q} C(p,a) C(q,b) m_ab w_{p-a,q-b}``, with
+    ``w_rs = sum |W|^2 kx^r ky^s / sum |W|^2`` the window's own moments (w_00 = 1; for the
+    periodic Hann w_20 = (2 pi/Lx)^2/3, w_40 = (2 pi/Lx)^4/3, w_02, w_04 likewise, w_22 =
+    w_20 w_02, odd ones 0). This triangular system is solved for m_pq order by order, e.g.
+    m20 = M20 - w_20 m00, m40 = M40 - 6 w_20 m20 - w_40 m00, m22 = M22 - w_02 m20 - w_20 m02 -
+    w_22 m00, m31 = M31 - 3 w_20 m11. The correction is exact in expectation (wavenumbers
+    within one bin of the Nyquist bin excepted); on one map the window widens each spectral
+    line over three bins, i.e. fewer independent samples.
+
+    Args:
+        z: heights, shape (nx, ny), axis 0 along x [unit].
+        dx, dy: sampling steps [unit] (dy defaults to dx).
+        unit: length unit of z, dx, dy ("um", "mm" or "m").
+        window: "none" (periodic map) or "hann" (with the correction above).
+    Returns:
+        MomentTensor in the map axes (stored in mm).
+    """
+    z = np.asarray(z, dtype=float)
+    if z.ndim != 2 or min(z.shape) < 3:
+        raise ValueError(f"z.shape = {z.shape} is invalid: a 2D map of at least 3x3 samples is needed")
+    if not np.all(np.isfinite(z)):
+        raise ValueError("z contains NaN/inf values: all heights must be finite")
+    dx = _check_positive("dx", dx)
+    dy = dx if dy is None else _check_positive("dy", dy)
+    nx, ny = z.shape
+    w = np.outer(_window_1d(nx, window), _window_1d(ny, window))
+    P, kx, ky = _power_spectrum(w * (z - z.mean()), dx, dy)
+    Pw, _, _ = _power_spectrum(w, dx, dy)
+    norm = Pw.sum()                      # <w^2> (Parseval)
+    kxp = [np.ones_like(kx), kx, kx**2, kx**3, kx**4]
+    kyp = [np.ones_like(ky), ky, ky**2, ky**3, ky**4]
+    raw = {(p, q): float((P * kxp[p] * kyp[q]).sum()) / norm for p, q in MOMENT_ORDERS}
+    m = {}
+    if window == "none":
+        m = raw
+    else:
+        wmom = {(r, s_): float((Pw * kxp[r] * kyp[s_]).sum()) / norm
+                for r in range(5) for s_ in range(5) if r + s_ <= 4}
+        for p, q in MOMENT_ORDERS:      # increasing order: lower moments are known
+            acc = raw[(p, q)]
+            for a, b in MOMENT_ORDERS:
+                if a <= p and b <= q and (a, b) != (p, q):
+                    acc -= math.comb(p, a) * math.comb(q, b) * m[(a, b)] * wmom[(p - a, q - b)]
+            m[(p, q)] = acc / wmom[(0, 0)]
+    return MomentTensor(*(m[o] for o in MOMENT_ORDERS), unit=unit)

@@ -28,6 +28,17 @@ interpolant built once per surface and material:
   interpolant of p is non-increasing everywhere (k >= 0), and k is the *exact* derivative of the
   interpolant (consistent tangent: Newton converges quadratically). p is C1 (k is continuous);
   dk/dh is exact inside every interval (it jumps at knots).
+  **The build either reaches rtol or stops** with :class:`TableAccuracyError`, which states the
+  accuracy reached, where (h range) and what to change. Two reasons: (i) *model-limited* — the
+  check error of a cubic Hermite interpolant falls 8-16x per bisection for a smooth model whose
+  stiffness is the derivative of its pressure; an interval still failing after two bisections that
+  each cut its error by less than 2x is limited by the model (e.g. a population integral whose
+  quadrature error exceeds rtol/2 there: the table cannot match both the model's k and the slope
+  of its p, since its k is the exact slope of its p), so refining it further is useless; (ii) the
+  budget: ``max_knots`` and ``max_seconds`` (wall time; a round that the measured cost per model
+  evaluation says would overrun it is not started). The detector leaves converging builds
+  alone: the tables of 8 non-degenerate population laws (Tables 1-2, the beam's surfaces, GW,
+  elastic, elasto-plastic) are bit-identical to those built without it.
 * **Taper** ``h_table_end < h < h_max``: ``p = P (1 - t)^3``, ``t = (h - h_table_end)/L`` with
   ``L = 3 P/K`` where P, K are the table's end values; this is the cubic Hermite curve from
   (P, slope -K) to (0, slope 0), monotone, C1 at both ends (and C2 at ``h_max``). The model's
@@ -58,6 +69,8 @@ wider than the shortest interval maps a point to its interval with one gather an
 
 from __future__ import annotations
 
+import inspect
+import time
 from dataclasses import dataclass, field
 from typing import Callable, Optional, Tuple
 
@@ -65,7 +78,7 @@ import numpy as np
 
 from ..validation import check_scalar
 
-__all__ = ["NormalLaw"]
+__all__ = ["NormalLaw", "TableAccuracyError"]
 
 Model = Callable[[np.ndarray], Tuple[np.ndarray, np.ndarray, np.ndarray]]
 
@@ -74,14 +87,28 @@ Model = Callable[[np.ndarray], Tuple[np.ndarray, np.ndarray, np.ndarray]]
 # (t = 1/2 -/+ 1/sqrt(12)).
 _CHECK_T = np.array([0.25, 0.5, 0.75])
 _MAX_LUT = 1 << 22
+_RTOL_MIN, _RTOL_MAX = 1e-12, 0.1
 _BLOCK = 4096
 
 
 # ----------------------------------------------------------------------------------------------
 # validation helpers
 # ----------------------------------------------------------------------------------------------
+def _check_budget(max_knots, max_seconds, n_initial: int) -> Tuple[int, float]:
+    try:
+        mk = int(max_knots)
+    except (TypeError, ValueError, OverflowError):
+        mk = -1
+    if mk != max_knots or mk < n_initial + 1:
+        raise ValueError(f"max_knots = {max_knots!r} is outside the valid range: an integer "
+                         f">= n_initial + 1 = {n_initial + 1}")
+    ms = float(max_seconds) if max_seconds == np.inf else check_scalar(
+        "max_seconds", max_seconds, lo=0.0, unit="s")
+    return mk, ms
+
+
 def _check_rtol(rtol) -> float:
-    return check_scalar("rtol", rtol, lo=1e-12, hi=0.1, lo_open=False, hi_open=False)
+    return check_scalar("rtol", rtol, lo=_RTOL_MIN, hi=_RTOL_MAX, lo_open=False, hi_open=False)
 
 
 def _model_values(model: Model, h: np.ndarray) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -181,12 +208,131 @@ def _limited_slopes(x: np.ndarray, y: np.ndarray) -> np.ndarray:
 # ----------------------------------------------------------------------------------------------
 # adaptive table
 # ----------------------------------------------------------------------------------------------
+# An interval whose check error has not at least halved over this many successive bisections is
+# taken to be limited by the model, not by the table (see _adaptive_table).
+_STALL_GENERATIONS = 2
+_STALL_RATIO = 0.5
+
+
+class TableAccuracyError(ValueError):
+    """The normal-law table could not reach the requested accuracy (see :meth:`NormalLaw.from_model`).
+
+    A ``ValueError`` (bad combination of model and rtol), raised with what was reached and where.
+
+    Attributes:
+        reason: ``"model-limited"`` (refining no longer reduces the error: the model is less
+            accurate, or less self-consistent, than rtol there), ``"max_knots"`` or
+            ``"max_seconds"`` (the build budget ran out first).
+        rtol: the requested relative accuracy.
+        reached: worst relative error vs the model at the check points of the failing
+            intervals, per quantity: ``{"pressure": .., "stiffness": .., "area_fraction": ..}``.
+        h_range: ``(h_a, h_b)`` [mm], the span of the failing intervals.
+        model_consistency: largest ``|k_model - (-dp_model/dh)| / k_model`` measured on the
+            failing intervals (the model's mid-interval stiffness against the central
+            difference of its own pressure over the interval): how far the model's stiffness is
+            from the derivative of its pressure.
+        knots: number of knots when the build stopped.
+        seconds: wall time of the build when it stopped [s].
+        advice: what to change, as a sentence.
+        length_scale: ``(name, value in mm)`` in which the message also shows h (e.g.
+            ``("sqrt(m00)", rq)``), or None.
+    """
+
+    def __init__(self, reason: str, rtol: float, reached: dict, h_range: Tuple[float, float],
+                 model_consistency: Optional[float], knots: int, seconds: float,
+                 advice: str, length_scale: Optional[Tuple[str, float]] = None):
+        self.reason = reason
+        self.rtol = rtol
+        self.reached = dict(reached)
+        self.h_range = (float(h_range[0]), float(h_range[1]))
+        self.model_consistency = model_consistency
+        self.knots = int(knots)
+        self.seconds = float(seconds)
+        self.advice = advice
+        self.length_scale = length_scale
+        super().__init__(self._message())
+
+    def _fields(self) -> tuple:
+        return (self.reason, self.rtol, self.reached, self.h_range, self.model_consistency,
+                self.knots, self.seconds, self.advice, self.length_scale)
+
+    def __reduce__(self):
+        # picklable (e.g. sent between processes): rebuilt from its fields, not the message
+        return (type(self), self._fields())
+
+    def with_advice(self, advice: str, length_scale: Optional[Tuple[str, float]] = None,
+                    seconds: Optional[float] = None) -> "TableAccuracyError":
+        """The same error with other advice, optionally h also shown in units of a length
+        ``(name, value in mm)`` and another wall time (e.g. including the caller's set-up)."""
+        return TableAccuracyError(self.reason, self.rtol, self.reached, self.h_range,
+                                  self.model_consistency, self.knots,
+                                  self.seconds if seconds is None else seconds, advice,
+                                  length_scale if length_scale is not None else self.length_scale)
+
+    def _message(self) -> str:
+        why = {
+            "model-limited": (
+                f"halving the failing intervals {_STALL_GENERATIONS} times did not reduce their "
+                "error (a cubic Hermite table's error falls 8-16x per halving when the model is "
+                "smooth and its stiffness is the derivative of its pressure): the model itself is "
+                "less accurate than rtol there"),
+            "max_knots": "the knot budget max_knots ran out",
+            "max_seconds": "the time budget max_seconds ran out (or the next refinement round "
+                           "would have exceeded it)",
+        }[self.reason]
+        r = self.reached
+        where = f"h in [{self.h_range[0]:.6g}, {self.h_range[1]:.6g}] mm"
+        if self.length_scale is not None:
+            name, scale = self.length_scale
+            where += (f" (h/{name} in [{self.h_range[0] / scale:.4g}, "
+                      f"{self.h_range[1] / scale:.4g}])")
+        msg = (f"normal-law table: rtol = {self.rtol:g} not reached ({why}). Reached "
+               f"{max(r.values()):.3g} (pressure {r['pressure']:.2g}, stiffness "
+               f"{r['stiffness']:.2g}, A/A0 {r['area_fraction']:.2g}, relative to the model at "
+               f"the check points) on {where}; rtol/2 elsewhere; {self.knots} knots, "
+               f"{self.seconds:.1f} s.")
+        if self.model_consistency is not None:
+            msg += (f" There the model's stiffness differs from the derivative of its own "
+                    f"pressure by up to {self.model_consistency:.2g} (relative).")
+        return msg + " " + self.advice
+
+
+def _rtol_advice(reached: float) -> float:
+    """A looser rtol that the reached accuracy supports: 2x (the check tolerance is rtol/2), one
+    significant digit, rounded up."""
+    r = 2.0 * reached * (1.0 + 1e-9)
+    e = np.floor(np.log10(r))
+    return float(np.ceil(r / 10.0 ** e) * 10.0 ** e)
+
+
+def _rtol_text(reached: float) -> str:
+    r = _rtol_advice(reached)
+    if r > _RTOL_MAX:
+        return (f"no rtol in the valid range (<= {_RTOL_MAX:g}) covers the {reached:.2g} reached: "
+                "the model's stiffness is too far from the derivative of its pressure")
+    return f"a looser rtol (>= {r:.2g}, what the model supports here)"
+
+
 def _adaptive_table(model: Model, h_lo: float, h_hi: float, rtol: float, n_initial: int,
-                    max_knots: int, floors: Tuple[float, float, float], check: str = "quarter"):
+                    max_knots: int, floors: Tuple[float, float, float], check: str = "quarter",
+                    max_seconds: float = np.inf, t_start: Optional[float] = None):
     """Refine knots on [h_lo, h_hi] until the log-Hermite interpolant meets rtol/2 at check points.
 
-    Returns knots h (N+1,), and the model's p, k, a there, plus the number of model evaluations.
+    Stops with :class:`TableAccuracyError` when refining no longer helps or the budget runs out:
+
+    * **model-limited**: the check error of a cubic Hermite interpolant of a smooth model falls
+      16x (values) or 8x (slopes) per bisection once the interval resolves the model. An
+      interval still failing after :data:`_STALL_GENERATIONS` successive bisections that each
+      reduced its error less than 2x is limited by the model (quadrature noise, or a stiffness
+      that is not the derivative of the pressure): it is split no further, and once nothing else
+      needs refinement the build stops with the accuracy reached.
+    * **max_knots** / **max_seconds**: a round that would exceed either budget is not started
+      (its cost is predicted from the measured cost per model evaluation so far).
+
+    Returns knots h (N+1,), the model's p, k, a there, the number of model evaluations and the
+    worst check-point error.
     """
+    t_start = time.perf_counter() if t_start is None else t_start
     tol = 0.5 * rtol
     fp, fk, fa = floors
     if check == "quarter":
@@ -197,18 +343,46 @@ def _adaptive_table(model: Model, h_lo: float, h_hi: float, rtol: float, n_initi
         raise ValueError(f"check = {check!r} is invalid: valid values are 'quarter', 'midpoint'")
     nt = check_t.size
     h = np.linspace(h_lo, h_hi, n_initial + 1)
+    t_eval = time.perf_counter()
     p, k, a = _model_values(model, h)
     n_eval = h.size
+    sec_eval = time.perf_counter() - t_eval      # wall time spent in the model
     # check-point data of every interval, (n_int, nt); NaN where not evaluated yet
     cp = np.full((n_initial, nt), np.nan)
     ck = cp.copy()
     ca = cp.copy()
+    # per interval: check error of its parent (inf: none) and the number of successive
+    # bisections that reduced the error less than 2x
+    parent_err = np.full(n_initial, np.inf)
+    stall = np.zeros(n_initial, dtype=np.intp)
+
+    def stop(reason, bad):
+        """TableAccuracyError for the intervals flagged in bad (or the worst one)."""
+        idx = np.flatnonzero(bad) if bad.any() else np.array([int(np.argmax(err))])
+        reached = {name: float(e[idx].max()) for name, e in zip(
+            ("pressure", "stiffness", "area_fraction"), errs)}
+        # the model's own consistency over the interval: its mid-interval stiffness against the
+        # central difference of its pressure (truncation error O(dx^2), negligible on the small
+        # intervals where refinement stalls)
+        dxs = np.diff(h)[idx]
+        fd = (p[idx] - p[idx + 1]) / dxs
+        kc = ck[idx, mid]
+        cons = float(np.max(np.abs(kc - fd) / np.maximum(kc, fk)))
+        advice = ("To change: " + _rtol_text(max(reached.values()))
+                  + "; or make the model more accurate there"
+                  + ("; or raise max_knots" if reason == "max_knots" else "")
+                  + ("; or raise max_seconds" if reason == "max_seconds" else "") + ".")
+        return TableAccuracyError(reason, rtol, reached, (h[idx].min(), h[idx + 1].max()),
+                                  cons, h.size, time.perf_counter() - t_start, advice)
+
     for _ in range(200):
         need = np.isnan(cp[:, 0])
         if need.any():
             idx = np.flatnonzero(need)
             hx = h[idx, None] + (h[idx + 1] - h[idx])[:, None] * check_t[None, :]
+            t_eval = time.perf_counter()
             pv, kv, av = _model_values(model, hx)
+            sec_eval += time.perf_counter() - t_eval
             n_eval += hx.size
             cp[idx], ck[idx], ca[idx] = pv, kv, av
         dxs = np.diff(h)
@@ -227,11 +401,9 @@ def _adaptive_table(model: Model, h_lo: float, h_hi: float, rtol: float, n_initi
         pi = np.exp(_horner(cq[:, :, None], t))
         ki = -pi * _horner_dt(cq[:, :, None], t) / dxs[:, None]
         ai = np.exp(_horner(ca_[:, :, None], t))
-        err = np.maximum.reduce([
-            np.abs(pi - cp) / np.maximum(cp, fp),
-            np.abs(ki - ck) / np.maximum(ck, fk),
-            np.abs(ai - ca) / np.maximum(ca, fa),
-        ]).max(axis=1)
+        errs = [(np.abs(pi - cp) / np.maximum(cp, fp)).max(axis=1),
+                (np.abs(ki - ck) / np.maximum(ck, fk)).max(axis=1),
+                (np.abs(ai - ca) / np.maximum(ca, fa)).max(axis=1)]
         if check == "midpoint":
             # The slope error of a cubic Hermite interpolant is (asymptotically) largest at
             # t = 1/2 -/+ 1/sqrt(12), where it is 3.08/dx times the value error at t = 1/2; the
@@ -243,21 +415,31 @@ def _adaptive_table(model: Model, h_lo: float, h_hi: float, rtol: float, n_initi
             # ln a uses three-point slopes: its error is not symmetric about t = 1/2 and peaks
             # up to ~3x higher elsewhere in the interval (measured), hence the factor 4
             ea = 4.0 * np.abs(ai[:, 0] - ca[:, 0]) / np.maximum(ca[:, 0], fa)
-            err = np.maximum.reduce([err, est, ea])
+            errs[1] = np.maximum(errs[1], est)
+            errs[2] = np.maximum(errs[2], ea)
+        err = np.maximum.reduce(errs)
         mono = _monotone_hermite(np.diff(q), dq[:-1] * dxs, dq[1:] * dxs)
-        fail = (err > tol) | ~mono
+        bad = (err > tol) | ~mono
+        # stagnation: freshly checked intervals whose error fell less than 2x since their parent
+        fresh = need
+        slow = fresh & bad & (err > _STALL_RATIO * parent_err)
+        stall = np.where(fresh, np.where(slow, stall + 1, 0), stall)
+        limited = bad & (stall >= _STALL_GENERATIONS)
+        fail = bad & ~limited
         # 2:1 grading (an interval is at most twice as wide as its neighbours): keeps the
         # three-point slopes of ln a accurate and makes refinement fronts advance in one round
         nb = np.minimum(np.concatenate([[np.inf], dxs[:-1]]), np.concatenate([dxs[1:], [np.inf]]))
         fail |= dxs > 2.0 * nb * (1.0 + 1e-9)
         if not fail.any():
+            if limited.any():
+                raise stop("model-limited", limited)
             return h, p, k, a, n_eval, float(err.max())
         if h.size + fail.sum() > max_knots:
-            raise ValueError(
-                f"rtol = {rtol!r} could not be reached with max_knots = {max_knots} knots (worst "
-                f"relative error {err.max():.3g} near h = {h[np.argmax(err)]!r} mm): the model is "
-                "probably less accurate than rtol (loosen rtol to at least the model's own "
-                "accuracy), or its stiffness is not the derivative of its pressure")
+            raise stop("max_knots", bad)
+        # time budget: do not start a round that the measured cost says would overrun it
+        n_next = 2 * int(fail.sum()) * nt
+        if time.perf_counter() - t_start + sec_eval / n_eval * n_next > max_seconds:
+            raise stop("max_seconds", bad)
         fi = np.flatnonzero(fail)
         # split failing intervals at their midpoints (check point t = 1/2 becomes a knot)
         hm = 0.5 * (h[fi] + h[fi + 1])
@@ -266,7 +448,7 @@ def _adaptive_table(model: Model, h_lo: float, h_hi: float, rtol: float, n_initi
         p = np.insert(p, pos, cp[fi, mid])
         k = np.insert(k, pos, ck[fi, mid])
         a = np.insert(a, pos, ca[fi, mid])
-        # interval fi becomes two: both need fresh check points
+        # interval fi becomes two: both need fresh check points and inherit its error history
         keep = ~fail
         new_n = h.size - 1
         ncp = np.full((new_n, nt), np.nan)
@@ -278,8 +460,28 @@ def _adaptive_table(model: Model, h_lo: float, h_hi: float, rtol: float, n_initi
         ncp[newpos[keep]] = cp[keep]
         nck[newpos[keep]] = ck[keep]
         nca[newpos[keep]] = ca[keep]
-        cp, ck, ca = ncp, nck, nca
+        npe = np.repeat(np.where(fail, err, parent_err), np.where(fail, 2, 1))
+        nst = np.repeat(stall, np.where(fail, 2, 1))
+        cp, ck, ca, parent_err, stall = ncp, nck, nca, npe, nst
     raise ValueError(f"rtol = {rtol!r}: table refinement did not converge in 200 rounds")
+
+
+def _population_advice(fn, name: str, kwargs: dict, e: TableAccuracyError) -> str:
+    """What to change when a population law's table stops short of rtol (for the error)."""
+    todo = [_rtol_text(max(e.reached.values()))]
+    params = inspect.signature(fn).parameters
+    if "n_quad" in params:
+        nq = int(kwargs["n_quad"]) if "n_quad" in kwargs else int(params["n_quad"].default)
+        todo.append(f"more population quadrature (n_quad = {nq} now; the population integral's "
+                    "error falls quickly with n_quad, its cost grows about as n_quad^3)")
+    if name == "elasto_plastic":
+        todo.append("the elastic law NormalLaw.elastic (no asperity plasticity), if plasticity "
+                    "is negligible at the loads of interest")
+    if e.reason == "max_knots":
+        todo.append("a larger max_knots")
+    if e.reason == "max_seconds":
+        todo.append("a larger max_seconds")
+    return "To change: " + "; or ".join(todo) + "."
 
 
 # ----------------------------------------------------------------------------------------------
@@ -398,7 +600,8 @@ class NormalLaw:
     @classmethod
     def from_model(cls, model: Model, h_range: Tuple[float, float], rtol: float = 1e-5, *,
                    n_initial: int = 16, max_knots: int = 20000,
-                   floor: float = 1e-15, check: str = "quarter") -> "NormalLaw":
+                   max_seconds: float = 300.0, floor: float = 1e-15,
+                   check: str = "quarter") -> "NormalLaw":
         """Build the law from any model ``h -> (p, k, a)`` on ``h_range = (h_min, h_table_end)``.
 
         Args:
@@ -409,7 +612,11 @@ class NormalLaw:
                 h_min the stiff continuation applies; beyond h_table_end the taper to zero.
             rtol: relative accuracy of p, k and a at every point of the table, in [1e-12, 0.1].
             n_initial: number of uniform intervals to start refining from.
-            max_knots: refinement limit; exceeding it raises ValueError.
+            max_knots: knot budget; a refinement round that would exceed it is not started
+                and :class:`TableAccuracyError` is raised instead.
+            max_seconds: wall-time budget of the build [s] (np.inf: none); a refinement round
+                that the measured cost per model evaluation says would exceed it is not started
+                and :class:`TableAccuracyError` is raised instead.
             floor: errors are relative to max(|value|, floor * value at h_min) (guards zeros).
             check: "quarter" compares p, k, a with the model at t = 1/4, 1/2, 3/4 of every
                 interval (3 model evaluations per interval, robust); "midpoint" only at t = 1/2
@@ -418,8 +625,12 @@ class NormalLaw:
 
         Raises:
             ValueError: bad arguments, a model returning non-finite / out-of-range values or a
-                non-monotone pressure, or an rtol the model cannot support.
+                non-monotone pressure.
+            TableAccuracyError: (a ValueError) rtol not reached: the model is less accurate or
+                less self-consistent than rtol somewhere (refinement stalls there), or the
+                budget ran out. The error states the accuracy reached, where, and what to change.
         """
+        t_start = time.perf_counter()
         rtol = _check_rtol(rtol)
         try:
             h_lo, h_hi = (float(v) for v in h_range)
@@ -431,13 +642,15 @@ class NormalLaw:
         n_initial = int(n_initial)
         if n_initial < 2:
             raise ValueError(f"n_initial = {n_initial} is outside the valid range [2, inf)")
+        max_knots, max_seconds = _check_budget(max_knots, max_seconds, n_initial)
         p_ref, k_ref, a_ref = (float(v[0]) for v in _model_values(model, np.array([h_lo])))
         floors = (floor * p_ref, floor * k_ref, floor * a_ref)
         h, p, k, a, n_eval, worst = _adaptive_table(model, h_lo, h_hi, rtol, n_initial,
-                                                    int(max_knots), floors, check)
+                                                    max_knots, floors, check, max_seconds,
+                                                    t_start)
         q, la = np.log(p), np.log(a)
         info = {"model_evaluations": n_eval + 1, "worst_checkpoint_error": worst,
-                "knots": h.size}
+                "knots": h.size, "build_seconds": time.perf_counter() - t_start}
         return cls._assemble(h, q, -k / p, la, _limited_slopes(h, la), True, rtol, info)
 
     @classmethod
@@ -510,8 +723,10 @@ class NormalLaw:
 
     @classmethod
     def _from_population(cls, fn, surface, param, rtol, area_limit, depth, tail, kwargs, name,
-                         check):
+                         check, max_knots: int = 20000, max_seconds: float = 300.0):
+        t_start = time.perf_counter()
         rtol = _check_rtol(rtol)
+        max_knots, max_seconds = _check_budget(max_knots, max_seconds, 16)
         area_limit = check_scalar("area_limit", area_limit, lo=0.0, hi=1.0)
         depth = check_scalar("depth", depth, lo=0.0, lo_open=False)
         tail = check_scalar("tail", tail, lo=0.0, hi=1e-2)
@@ -567,8 +782,18 @@ class NormalLaw:
                                  f"p_ref = {p_ref!r} MPa up to h = {grid[-1]!r} mm (40 sigma)")
             h_hi = float(grid[pos[-1]])
         n_scan = calls[0]
-        law = cls.from_model(model, (h_lo, h_hi), rtol, check=check)
+        remaining = max_seconds - (time.perf_counter() - t_start)
+        if not remaining > 0.0:
+            raise ValueError(f"max_seconds = {max_seconds!r} s is too small: the {name} model's "
+                             f"range scan alone took {time.perf_counter() - t_start:.3g} s")
+        try:
+            law = cls.from_model(model, (h_lo, h_hi), rtol, check=check, max_knots=max_knots,
+                                 max_seconds=remaining)
+        except TableAccuracyError as e:
+            raise e.with_advice(_population_advice(fn, name, kwargs, e), ("sqrt(m00)", sigma),
+                                time.perf_counter() - t_start) from None
         law.info.update({"model": name, "sigma_mm": sigma, "area_limit": area_limit,
+                         "build_seconds": time.perf_counter() - t_start,
                          "depth": depth, "tail": tail, "p_ref": p_ref,
                          "range_scan_evaluations": n_scan,
                          "model_evaluations": calls[0]})
@@ -577,6 +802,7 @@ class NormalLaw:
     @classmethod
     def elastic(cls, surface, E_star: float, rtol: float = 1e-4, *, area_limit: float = 0.3,
                 depth: float = 3.0, tail: float = 1e-12, check: str = "midpoint",
+                max_knots: int = 20000, max_seconds: float = 300.0,
                 **model_kwargs) -> "NormalLaw":
         """Law of the strongly anisotropic elastic population, eqs (52), (53), (55).
 
@@ -591,35 +817,52 @@ class NormalLaw:
             tail: the table ends where p <= tail * p(max(h_min, 0)).
             check: refinement check mode, see :meth:`from_model` ("midpoint": about half the
                 population evaluations of "quarter").
+            max_knots, max_seconds: build budget (knots; wall time in s, including the range
+                scan), see :meth:`from_model`.
             **model_kwargs: passed on to :func:`rough_contact.population.elastic`.
+
+        Raises:
+            TableAccuracyError: rtol not reached (the population integral is less accurate than
+                rtol somewhere, or the budget ran out), with the accuracy reached, where (h and
+                h/sqrt(m00)) and what to change (rtol, n_quad, budget).
         """
         from rough_contact import population
 
         check_scalar("E_star", E_star, lo=0.0, unit="MPa")
         return cls._from_population(population.elastic, surface, E_star, rtol, area_limit,
-                                    depth, tail, model_kwargs, "elastic", check)
+                                    depth, tail, model_kwargs, "elastic", check,
+                                    max_knots=max_knots, max_seconds=max_seconds)
 
     @classmethod
     def elasto_plastic(cls, surface, material, rtol: float = 1e-4, *, area_limit: float = 0.3,
                        depth: float = 3.0, tail: float = 1e-12, check: str = "midpoint",
+                       max_knots: int = 20000, max_seconds: float = 300.0,
                        **model_kwargs) -> "NormalLaw":
         """Law of the elasto-plastic population, eqs (78)-(88) (reversible, see module doc).
 
         Args:
             surface: :class:`rough_contact.surface.SpectralMoments`.
             material: :class:`rough_contact.asperity.AsperityMaterial`.
-            rtol, area_limit, depth, tail: as in :meth:`elastic`.
+            rtol, area_limit, depth, tail, check, max_knots, max_seconds: as in
+                :meth:`elastic`.
             **model_kwargs: passed on to :func:`rough_contact.population.elasto_plastic`.
+
+        Raises:
+            TableAccuracyError: as in :meth:`elastic`. Nearly degenerate moments (mu = 1 - beta1
+                - beta2 of order 0.01) are where the elasto-plastic population integral at the
+                default n_quad is least accurate (its stiffness to ~1e-3).
         """
         from rough_contact import population
 
         return cls._from_population(population.elasto_plastic, surface, material, rtol,
-                                    area_limit, depth, tail, model_kwargs, "elasto_plastic", check)
+                                    area_limit, depth, tail, model_kwargs, "elasto_plastic", check,
+                                    max_knots=max_knots, max_seconds=max_seconds)
 
     @classmethod
     def greenwood_williamson(cls, surface, E_star: float, rtol: float = 1e-4, *,
                              area_limit: float = 0.3, depth: float = 3.0, tail: float = 1e-12,
-                             check: str = "midpoint", **model_kwargs) -> "NormalLaw":
+                             check: str = "midpoint", max_knots: int = 20000,
+                             max_seconds: float = 300.0, **model_kwargs) -> "NormalLaw":
         """Law of McCool's equivalent Greenwood-Williamson model (``docs/equations.md``).
 
         Args: as in :meth:`elastic`; **model_kwargs go to
@@ -630,7 +873,7 @@ class NormalLaw:
         check_scalar("E_star", E_star, lo=0.0, unit="MPa")
         return cls._from_population(population.greenwood_williamson, surface, E_star, rtol,
                                     area_limit, depth, tail, model_kwargs, "greenwood_williamson",
-                                    check)
+                                    check, max_knots=max_knots, max_seconds=max_seconds)
 
     # ------------------------------------------------------------------ evaluation
     def _check_h(self, h) -> np.ndarray:

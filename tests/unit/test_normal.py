@@ -6,13 +6,15 @@ Greenwood-Williamson integrals, central finite differences, analytic laws.
 from __future__ import annotations
 
 import importlib.util
+import pickle
+import time
 
 import numpy as np
 import pytest
 from scipy.integrate import quad
 from scipy.special import gamma, pbdv
 
-from rough_contact.interface.normal import NormalLaw
+from rough_contact.interface.normal import NormalLaw, TableAccuracyError
 
 # ----------------------------------------------------------------------------------------------
 # An independent Greenwood-Williamson law (McCool's equivalent model, docs/equations.md), mm/MPa.
@@ -443,3 +445,110 @@ def test_from_table_end_slope_and_continuation():
     xs = _away_from_knots(law, np.linspace(-5.0, law.h_max, 997), delta)
     k_fd = (law.evaluate(xs - delta)[0] - law.evaluate(xs + delta)[0]) / (2 * delta)
     assert np.allclose(law.evaluate(xs)[1], k_fd, rtol=1e-6, atol=1e-9)
+
+
+# ----------------------------------------------------------------------------------------------
+# build guard (issue 12): the build reaches rtol or stops with what it reached, where, and why
+# ----------------------------------------------------------------------------------------------
+def _inconsistent(h):
+    """GW with a stiffness 1.3x the derivative of its pressure."""
+    p, k, a = gw(h)
+    return p, 1.3 * k, a
+
+
+def test_inconsistent_model_stops_as_model_limited_with_the_analytic_figures():
+    # With end slopes 1.3x the secant, a cubic Hermite segment's mid-interval slope tends to
+    # 1.5 secant - 0.5 * 1.3 secant = 0.85 secant: the table's k misses the model's 1.3 k by
+    # 0.45/1.3 = 0.346 there (the worst of t = 1/4, 1/2, 3/4), and the model's own k departs from
+    # the slope of its p by 0.3/1.3 = 0.231. Neither shrinks with refinement.
+    t0 = time.perf_counter()
+    with pytest.raises(TableAccuracyError) as info:
+        NormalLaw.from_model(_inconsistent, (H_LO, H_HI), rtol=1e-6)
+    e = info.value
+    assert time.perf_counter() - t0 < 5.0
+    assert e.reason == "model-limited"
+    assert e.reached["stiffness"] == pytest.approx(0.45 / 1.3, rel=0.05)
+    assert e.model_consistency == pytest.approx(0.3 / 1.3, rel=0.05)
+    assert H_LO <= e.h_range[0] < e.h_range[1] <= H_HI
+    assert e.knots < 2000
+    msg = str(e)
+    for part in ("rtol = 1e-06 not reached", "did not reduce their error", "stiffness 0.3",
+                 "h in [", "derivative of its own pressure", "no rtol in the valid range"):
+        assert part in msg, (part, msg)
+    assert isinstance(e, ValueError)          # callers catching ValueError keep working
+    again = pickle.loads(pickle.dumps(e))     # e.g. sent between processes
+    assert str(again) == msg and again.reached == e.reached
+
+
+def test_noisy_model_stops_and_the_advised_rtol_then_succeeds():
+    # p carries a relative ripple of 2e-5 on a scale of sigma/40, like quadrature noise: the
+    # table converges down to that level and stalls below it.
+    eps, lam = 2e-5, SIGMA / 40
+
+    def noisy(h):
+        p, k, a = gw(h)
+        return p * (1 + eps * np.sin(2 * np.pi * h / lam)), k, a
+
+    with pytest.raises(TableAccuracyError) as info:
+        NormalLaw.from_model(noisy, (H_LO, H_HI), rtol=1e-6, check="midpoint")
+    e = info.value
+    assert e.reason == "model-limited"
+    assert max(e.reached.values()) > 0.5e-6
+    rtol = float(str(e).split("a looser rtol (>= ")[1].split(",")[0])
+    assert 1e-6 < rtol <= 0.1
+    law = NormalLaw.from_model(noisy, (H_LO, H_HI), rtol=rtol, check="midpoint")
+    h = np.random.default_rng(4).uniform(H_LO, H_HI, 4000)
+    p, k, a = law.evaluate(h)
+    P, K, A = noisy(h)
+    assert np.max(np.abs(p / P - 1)) <= rtol
+    assert np.max(np.abs(k / K - 1)) <= rtol
+
+
+def test_budget_knobs_stop_the_build_with_what_was_reached():
+    with pytest.raises(TableAccuracyError) as info:
+        NormalLaw.from_model(gw, (H_LO, H_HI), rtol=1e-9, max_knots=60)
+    e = info.value
+    assert e.reason == "max_knots" and e.knots <= 60
+    assert "max_knots" in str(e) and "raise max_knots" in str(e)
+    assert max(e.reached.values()) > 0.5e-9
+
+    def slow(h):                              # 2 ms per separation
+        time.sleep(2e-3 * np.size(h))
+        return gw(h)
+
+    t0 = time.perf_counter()
+    with pytest.raises(TableAccuracyError) as info:
+        NormalLaw.from_model(slow, (H_LO, H_HI), rtol=1e-9, max_seconds=0.5)
+    assert info.value.reason == "max_seconds"
+    # the round that would overrun is not started (slack: one evaluation call of jitter)
+    assert time.perf_counter() - t0 < 0.5 + 0.3
+    assert "max_seconds" in str(info.value)
+    for kw, match in (({"max_knots": 3}, "max_knots"), ({"max_knots": 1.5}, "max_knots"),
+                      ({"max_seconds": 0.0}, "max_seconds"),
+                      ({"max_seconds": np.nan}, "max_seconds")):
+        with pytest.raises(ValueError, match=match):
+            NormalLaw.from_model(gw, (H_LO, H_HI), **kw)
+
+
+@needs_population
+def test_nearly_degenerate_elasto_plastic_build_ends_with_a_clear_error():
+    """Issue 12: Table 1 surface with m00 x 0.2 (mu = 0.0154), psi = 1, rtol 1e-4 refined for
+    minutes. Here a coarse population quadrature (n_quad = 12, ~8x cheaper) and the knot budget
+    keep the test at ~3 CPU s; with the defaults the build ends by itself, model-limited, after
+    47 knots (16 CPU s, 28 s wall on the loaded 2-core machine; issue 12's report)."""
+    from rough_contact.asperity import AsperityMaterial
+    from rough_contact.surface import SpectralMoments
+
+    surface = SpectralMoments(0.2 * M00, M20, M02, M40, M04, unit="um")
+    assert surface.mu == pytest.approx(0.0154, abs=1e-4)
+    material = AsperityMaterial.from_plasticity_index(surface, 1.0, E_STAR)
+    with pytest.raises(TableAccuracyError) as info:
+        NormalLaw.elasto_plastic(surface, material, rtol=1e-4, max_knots=20, n_quad=12)
+    e = info.value
+    msg = str(e)
+    assert e.reason in ("max_knots", "model-limited")
+    for part in ("rtol = 0.0001 not reached", "h/sqrt(m00) in [", "NormalLaw.elastic",
+                 "n_quad = 12", "a looser rtol"):
+        assert part in msg, (part, msg)
+    lo, hi = (v / surface.rq for v in e.h_range)
+    assert -3.0 <= lo < hi                     # inside the table range
