@@ -68,24 +68,23 @@ def run_punch(args, petsc_args):
     from rough_contact.solver.parallel import abort_on_uncaught_exception
 
     abort_on_uncaught_exception()  # one failing rank must not leave the others waiting
-    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-    import demo_flat_punch as demo
+    from rough_contact.scenes import flat_punch
 
     from rough_contact.fem.interface_output import InterfaceWriter, prepare_output_dir
     from rough_contact.solver.loading import load_path, load_unload_factors
 
     comm = MPI.COMM_WORLD
     prepare_output_dir(args.results, comm, overwrite=args.overwrite)
-    m = demo.build(comm, mesh_size=args.mesh_size, contact_size=args.contact_size,
-                   order=args.order, steps=args.steps)
-    interface = m["interface"]
+    m = flat_punch.build(comm, mesh_size=args.mesh_size, contact_size=args.contact_size,
+                         order=args.order, steps=args.steps)
+    interface = m.interface
     writer = InterfaceWriter(args.results, interface, points=True, overwrite=args.overwrite)
-    for inc in load_path(m["problem"], m["solver"], load_unload_factors(args.steps, 0),
+    for inc in load_path(m.problem, m.solver, load_unload_factors(args.steps, 0),
                          verbose=False):
         writer.write(inc.load_factor)
         PETSc.Sys.Print(f"  load factor {inc.load_factor:.4f}: Fz = {inc.contact_force[2]:.6g} N, "
                         f"{inc.n_slipping} of {inc.n_points} points slipping", comm=comm)
-    m["solver"].destroy()
+    m.solver.destroy()
     PETSc.Sys.Print(f"{interface.n_points_global} interface points on "
                     f"{len(writer.surface.cells) if comm.rank == 0 else '?'} facets written to "
                     f"{args.results}/", comm=comm)

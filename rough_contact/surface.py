@@ -452,8 +452,8 @@ def moment_tensor_from_height_map(z, dx: float, dy: float | None = None, unit: s
         raise ValueError(f"z.shape = {z.shape} is invalid: a 2D map of at least 3x3 samples is needed")
     if not np.all(np.isfinite(z)):
         raise ValueError("z contains NaN/inf values: all heights must be finite")
-    dx = _check_positive("dx", dx)
-    dy = dx if dy is None else _check_positive("dy", dy)
+    dx = check_scalar("dx", dx, lo=0.0)
+    dy = dx if dy is None else check_scalar("dy", dy, lo=0.0)
     nx, ny = z.shape
     w = np.outer(_window_1d(nx, window), _window_1d(ny, window))
     P, kx, ky = _power_spectrum(w * (z - z.mean()), dx, dy)

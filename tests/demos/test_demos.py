@@ -81,3 +81,17 @@ def test_demo_micro_model(tmp_path):
 def test_demo_friction_point(tmp_path):
     out = run([DEMOS / "demo_friction_point.py", "--out", tmp_path / "fp"], tmp_path)
     assert out.strip()
+
+
+def test_demo_measured_surface(tmp_path):
+    out = run([DEMOS / "demo_measured_surface.py", "--quick", "--out", tmp_path / "ms"],
+              tmp_path)
+    assert "grain" in out.lower()
+
+
+def test_plot_interface_pressure(tmp_path):
+    png = tmp_path / "pressure.png"
+    run([DEMOS / "plot_interface_pressure.py", "--run", "--results", tmp_path / "res",
+         "--out", png, "--mesh-size", "20", "--contact-size", "5", "--order", "1",
+         "--steps", "2"], tmp_path)
+    assert png.stat().st_size > 0

@@ -17,8 +17,7 @@ import pytest
 from rough_contact.surface import MomentTensor, SpectralMoments
 from rough_contact.topography import (AnisotropicGaussianPSD, HeightMap, analyze, detrend,
                                       read_height_map, read_instrument, read_npy, read_text_grid,
-                                      read_xyz, synthetic_height_map, write_height_map, write_npy,
-                                      write_xyz)
+                                      read_xyz, synthetic_height_map, write_height_map, write_npy)
 
 TABLE1 = dict(m00=0.0625, m20=8e-5, m02=8e-4, m40=1.04e-6, m04=1.04e-4)   # um convention
 NAMES = ("m00", "m20", "m11", "m02", "m40", "m31", "m22", "m13", "m04")
