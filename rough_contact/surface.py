@@ -210,6 +210,18 @@ def psum(w1, w4, w6, beta1: float, beta2: float):
     return np.where((w4 > 0) & (w6 > 0), out, 0.0)
 
 
+def _checked_map(z, dx, dy) -> Tuple[np.ndarray, float, float]:
+    """A finite 2D height map of at least 3x3 samples and positive steps, or ValueError."""
+    z = np.asarray(z, dtype=float)
+    if z.ndim != 2 or min(z.shape) < 3:
+        raise ValueError(f"z.shape = {z.shape} is invalid: a 2D map of at least 3x3 samples is needed")
+    if not np.all(np.isfinite(z)):
+        raise ValueError("z contains NaN/inf values: all heights must be finite")
+    dx = check_scalar("dx", dx, lo=0.0)
+    dy = dx if dy is None else check_scalar("dy", dy, lo=0.0)
+    return z, dx, dy
+
+
 def _wavenumbers(n: int, d: float) -> np.ndarray:
     """Angular wavenumbers of an n-point FFT with step d; the Nyquist bin (n even) is set to 0:
     the derivative of a real signal there is ambiguous."""
@@ -249,13 +261,7 @@ def moments_from_height_map(z, dx: float, dy: float | None = None, method: str =
     Raises:
         ValueError: for a non-2D or non-finite map, non-positive steps or unknown method.
     """
-    z = np.asarray(z, dtype=float)
-    if z.ndim != 2 or min(z.shape) < 3:
-        raise ValueError(f"z.shape = {z.shape} is invalid: a 2D map of at least 3x3 samples is needed")
-    if not np.all(np.isfinite(z)):
-        raise ValueError("z contains NaN/inf values: all heights must be finite")
-    dx = check_scalar("dx", dx, lo=0.0)
-    dy = dx if dy is None else check_scalar("dy", dy, lo=0.0)
+    z, dx, dy = _checked_map(z, dx, dy)
     z = z - z.mean()
     nx, ny = z.shape
     if method == "fft":
@@ -447,13 +453,7 @@ def moment_tensor_from_height_map(z, dx: float, dy: float | None = None, unit: s
     Returns:
         MomentTensor in the map axes (stored in mm).
     """
-    z = np.asarray(z, dtype=float)
-    if z.ndim != 2 or min(z.shape) < 3:
-        raise ValueError(f"z.shape = {z.shape} is invalid: a 2D map of at least 3x3 samples is needed")
-    if not np.all(np.isfinite(z)):
-        raise ValueError("z contains NaN/inf values: all heights must be finite")
-    dx = check_scalar("dx", dx, lo=0.0)
-    dy = dx if dy is None else check_scalar("dy", dy, lo=0.0)
+    z, dx, dy = _checked_map(z, dx, dy)
     nx, ny = z.shape
     w = np.outer(_window_1d(nx, window), _window_1d(ny, window))
     P, kx, ky = _power_spectrum(w * (z - z.mean()), dx, dy)
