@@ -115,5 +115,5 @@ if __name__ == "__main__":
         order=args.order, load_half_length=args.load_half_length, steps=args.steps,
         tangential=args.tangential, friction=args.friction, hardness=args.hardness,
         outdir=args.outdir, figdir=args.figdir, fig_suffix=args.fig_suffix,
-        dof_threshold=args.dof_threshold, xdmf=not args.no_xdmf)
+        dof_threshold=args.dof_threshold, xdmf=not args.no_xdmf, overwrite=True)
 

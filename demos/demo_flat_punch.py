@@ -99,5 +99,5 @@ if __name__ == "__main__":
     run(mesh_size=args.mesh_size, contact_size=args.contact_size, order=args.order,
         load_half_width=args.load_half_width, steps=args.steps, unload=not args.no_unload,
         law=args.law, case=args.case, normal_law=args.normal_law, outdir=args.outdir,
-        dof_threshold=args.dof_threshold)
+        dof_threshold=args.dof_threshold, overwrite=True)
 

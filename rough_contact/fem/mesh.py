@@ -7,7 +7,7 @@ faces share one conforming surface mesh. Before the mesh reaches DOLFINx, the no
 the *split body* (the owner of the first contact surface) shares with the other bodies
 are duplicated in numpy, so the bodies become disconnected parts of one mesh whose contact
 faces still carry identical facets (same vertex coordinates, different vertices). This is
-the "duplicate" route of ``DESIGN.md``: robust for any geometry, P1 and P2 alike, and it
+the "duplicate" route of ``docs/design.md``: robust for any geometry, P1 and P2 alike, and it
 needs no periodic node matching (this gmsh build lacks ANN).
 
 The gmsh model lives on one rank only; :func:`scene_from_gmsh` is collective and

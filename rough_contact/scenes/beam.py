@@ -288,19 +288,10 @@ def deflection_profile(comm, setup, uN_nodes, n_samples=251):
     return comm.bcast(out, root=0)
 
 
-def point_data(interface, gap_init):
-    """Interface fields at this rank's points (for the XDMF point cloud)."""
-    pf = interface.point_fields()
-    return interface.point_coordinates(), {
-        "pressure_MPa": pf.pressure, "area_fraction": pf.area_fraction, "gap_mm": pf.gap,
-        "uN_mm": pf.gap - gap_init, "slip_mm": pf.slip, "contact": pf.contact.astype(float),
-        "slipping": pf.slipping.astype(float)}
-
-
 # ## One case
 def run_case(comm, setup, case, steps=16, tangential="mindlin", friction="b", hardness="psi",
              outdir="results/beam", prefix="rc_", dof_threshold=200_000, verbose=True, xdmf=True,
-             beam_modulus=E1):
+             beam_modulus=E1, overwrite=False):
     """Load one Table 4 case; return its results. Collective.
 
     The result dict is identical on every rank except the point arrays ``points_y``,
@@ -324,9 +315,8 @@ def run_case(comm, setup, case, steps=16, tangential="mindlin", friction="b", ha
     state = {}
     writer = None
     if xdmf:
-        writer = ResultWriter(case_dir, comm, u=problem.u,
-                              point_data=lambda: point_data(interface, state["gap0"]),
-                              extra_columns=("force_error_rel",))
+        writer = ResultWriter(case_dir, comm, u=problem.u, interface=interface,
+                              extra_columns=("force_error_rel",), overwrite=overwrite)
     max_force_error, newton = 0.0, 0
     last = None
     for inc in load_path(problem, solver, c.factors, verbose=verbose):
@@ -472,7 +462,8 @@ def table(results) -> str:
 def run(cases=tuple(sorted(CASES)), mesh_size=40.0, contact_size=5.0, order=2,
          load_half_length=5.0, steps=16, tangential="mindlin", friction="b", hardness="psi",
          outdir="results/beam", figdir=None, fig_suffix="", prefix="rc_", dof_threshold=200_000,
-         comm=MPI.COMM_WORLD, verbose=True, plot=True, xdmf=True, beam_modulus=E1):
+         comm=MPI.COMM_WORLD, verbose=True, plot=True, xdmf=True, beam_modulus=E1,
+         overwrite=False):
     """Run the chosen Table 4 cases; return a list of result dicts (same on every rank).
 
     Args:
@@ -516,7 +507,7 @@ def run(cases=tuple(sorted(CASES)), mesh_size=40.0, contact_size=5.0, order=2,
     results = []
     for case in cases:
         results.append(run_case(comm, setup, case, steps, tangential, friction, hardness, outdir,
-                                prefix, dof_threshold, verbose, xdmf, beam_modulus))
+                                prefix, dof_threshold, verbose, xdmf, beam_modulus, overwrite))
     text = table(results)
     PETSc.Sys.Print("\n" + text + f"\n\nTotal wall time {MPI.Wtime() - t0:.1f} s on "
                     f"{comm.size} rank(s)", comm=comm)

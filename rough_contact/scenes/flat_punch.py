@@ -305,8 +305,12 @@ def plot_slip_directions(comm, interface, path, title, n_grid=12):
 # ## The run
 def run(mesh_size=20.0, contact_size=2.0, order=2, load_half_width=2.5, steps=16,
          unload=True, law="rough", case="b", normal_law="elasto-plastic", outdir="results/flat_punch",
-         prefix="rc_", dof_threshold=100_000, comm=MPI.COMM_WORLD, verbose=True, plot=True):
-    """Run the punch; return a dict of results (identical on every rank). Collective."""
+         prefix="rc_", dof_threshold=100_000, comm=MPI.COMM_WORLD, verbose=True, plot=True,
+         overwrite=False):
+    """Run the punch; return a dict of results (identical on every rank). Collective.
+
+    ``outdir`` receives one run: earlier results there make it refuse unless ``overwrite``.
+    """
     t0 = MPI.Wtime()
     m = build(comm, mesh_size, contact_size, order, load_half_width, law, case, normal_law,
               steps, prefix, dof_threshold)
@@ -318,9 +322,12 @@ def run(mesh_size=20.0, contact_size=2.0, order=2, load_half_width=2.5, steps=16
                     f"linear solver {solver.linear_solver}, {comm.size} rank(s)", comm=comm)
 
     factors = load_unload_factors(steps, steps - 1 if unload else 0)
-    writer = ResultWriter(outdir, comm, u=problem.u,
-                          point_data=lambda: point_data(interface),
-                          extra_columns=("force_error_rel",))
+    writer = ResultWriter(outdir, comm, u=problem.u, interface=interface,
+                          extra_columns=("force_error_rel",), overwrite=overwrite,
+                          extra_patterns=(r"slip_directions.*\.png",))
+    if writer.removed:
+        PETSc.Sys.Print(f"Replaced {len(writer.removed)} files of an earlier run in {outdir}/",
+                        comm=comm)
     history = []
     peak = None
     for inc in load_path(problem, solver, factors, verbose=verbose):

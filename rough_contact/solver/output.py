@@ -7,13 +7,14 @@ that was written stays readable:
 
 * ``displacement.xdmf/.h5``: DOLFINx ``XDMFFile``, reopened in append mode and closed at every
   step (so the HDF5 file is flushed and the XML index rewritten per step).
-* ``interface.xdmf``: the interface quadrature points as an XDMF ``Polyvertex`` point cloud with
-  one grid per step; the data of step k go to ``interface_<k>.bin`` (raw little-endian float64,
-  written to a temporary file then renamed), and the small XML index is rewritten atomically
-  (temporary file + ``os.replace``). ParaView reads it with the "XDMF Reader".
+* ``interface.xdmf/.h5``: the contact surface as facets with the interface fields per increment
+  (``rough_contact.fem.interface_output.InterfaceWriter``; ``interface_points.xdmf`` holds the
+  exact quadrature-point values), ParaView shows it by default (``docs/output.md``).
+* Time values are the load factor while the load rises from 0, then the load path's length
+  (``pseudo_time``): ParaView's time axis follows the load, never the step number.
+* The folder holds exactly one run: earlier results make the writer refuse, or with
+  ``overwrite=True`` they are removed first (``prepare_output_dir``).
 * ``history.csv``: one row per converged increment, rewritten atomically.
-
-Point fields come gathered to rank 0 in global point order (rank by rank).
 """
 
 from __future__ import annotations
@@ -21,7 +22,7 @@ from __future__ import annotations
 import csv
 import io
 import os
-from typing import Iterable, Optional, Union
+from typing import Iterable, Optional, Sequence, Union
 
 import numpy as np
 from mpi4py import MPI
@@ -90,29 +91,39 @@ _CSV_COLUMNS = [
 
 
 class ResultWriter:
-    """Write displacement, interface point fields and a CSV history for each increment.
+    """Write displacement, interface fields on the contact surface and a CSV history per increment.
 
     Args:
-        outdir: output directory (created).
+        outdir: output directory (created; it must not hold an earlier run's results unless
+            ``overwrite``).
         comm: communicator.
         u: displacement function (written to ``displacement.xdmf``), or ``None``.
-        point_data: callable returning ``(points (n, 3), {name: (n,) or (n, k) array})`` for the
-            locally owned interface points, or ``None``.
+        interface: the contact interface whose fields go to ``interface.xdmf``, or ``None``.
+        points: also write the exact quadrature-point values (``interface_points.xdmf``).
         extra_columns: names of extra CSV columns filled from ``write(..., extra=)``.
+        overwrite: remove an earlier run's results from ``outdir`` instead of refusing.
+        extra_patterns: file-name patterns (regular expressions) of the caller's own outputs in
+            ``outdir`` that belong to a run (e.g. its figures), removed or refused alike.
+
+    Raises:
+        OutputExistsError: ``outdir`` holds an earlier run's results and ``overwrite`` is False.
     """
 
-    def __init__(self, outdir: str, comm: MPI.Comm, u=None, point_data=None,
-                 extra_columns: tuple = ()):
+    def __init__(self, outdir: str, comm: MPI.Comm, u=None, interface=None, *,
+                 points: bool = True, extra_columns: tuple = (), overwrite: bool = False,
+                 extra_patterns: Sequence[str] = ()):
+        from rough_contact.fem.interface_output import InterfaceWriter, prepare_output_dir
+
         self.outdir = os.fspath(outdir)
         self.comm = comm
-        if comm.rank == 0:
-            os.makedirs(self.outdir, exist_ok=True)
-        comm.barrier()
+        self.removed = prepare_output_dir(self.outdir, comm, overwrite=overwrite,
+                                          extra_patterns=extra_patterns)
         self.u = u
-        self.point_data = point_data
+        self.interface_writer = (None if interface is None
+                                 else InterfaceWriter(self.outdir, interface, points=points))
         self.extra_columns = tuple(extra_columns)
         self.rows: list = []
-        self.grids: list = []
+        self.load_factors: list = []
         self._u_out = None
         self._xdmf_started = False
         if u is not None:
@@ -128,7 +139,6 @@ class ResultWriter:
                     fem.VectorFunctionSpace(msh, ("Lagrange", degree)), name=u.name)
         self.csv_path = os.path.join(self.outdir, "history.csv")
         self.u_path = os.path.join(self.outdir, "displacement.xdmf")
-        self.pc_path = os.path.join(self.outdir, "interface.xdmf")
 
     # ------------------------------------------------------------------ displacement
     def _write_displacement(self, t: float) -> None:
@@ -142,48 +152,6 @@ class ResultWriter:
                 xdmf.write_mesh(self.u.function_space.mesh)
             xdmf.write_function(self._u_out, t)
         self._xdmf_started = True
-
-    # ------------------------------------------------------------------ point cloud
-    def _write_points(self, step: int, t: float) -> None:
-        pts, fields = self.point_data()
-        pts, fields = gather_points(self.comm, pts, fields)
-        if self.comm.rank != 0:
-            return
-        name = f"interface_{step:04d}.bin"
-        chunks, items, offset = [], [], 0
-        n = len(pts)
-        for key, arr in [("__geometry__", pts)] + list(fields.items()):
-            arr = np.ascontiguousarray(arr, dtype="<f8")
-            chunks.append(arr.tobytes())
-            items.append((key, arr.shape, offset))
-            offset += arr.nbytes
-        atomic_write(os.path.join(self.outdir, name), chunks)
-        self.grids.append((step, t, n, name, items))
-        atomic_write(self.pc_path, self._point_cloud_xml())
-
-    def _point_cloud_xml(self) -> str:
-        lines = ['<?xml version="1.0" ?>', '<Xdmf Version="3.0">', "  <Domain>",
-                 '    <Grid Name="interface" GridType="Collection" CollectionType="Temporal">']
-        for step, t, n, name, items in self.grids:
-            lines.append(f'      <Grid Name="step_{step}" GridType="Uniform">')
-            lines.append(f'        <Time Value="{t!r}"/>')
-            lines.append(f'        <Topology TopologyType="Polyvertex" NumberOfElements="{n}" '
-                         'NodesPerElement="1"/>')
-            for key, shape, off in items:
-                dims = " ".join(str(d) for d in shape)
-                item = (f'<DataItem Format="Binary" NumberType="Float" Precision="8" '
-                        f'Endian="Little" Seek="{off}" Dimensions="{dims}">{name}</DataItem>')
-                if key == "__geometry__":
-                    lines.append(f'        <Geometry GeometryType="XYZ">{item}</Geometry>')
-                else:
-                    # (n,) scalar, (n, 3) vector, anything else (e.g. (n, 2)) a matrix
-                    kind = "Scalar" if len(shape) == 1 else (
-                        "Vector" if shape[1] == 3 else "Matrix")
-                    lines.append(f'        <Attribute Name="{key}" AttributeType="{kind}" '
-                                 f'Center="Node">{item}</Attribute>')
-            lines.append("      </Grid>")
-        lines += ["    </Grid>", "  </Domain>", "</Xdmf>", ""]
-        return "\n".join(lines)
 
     # ------------------------------------------------------------------ CSV
     def _write_csv(self, inc, extra: Optional[dict]) -> None:
@@ -209,9 +177,12 @@ class ResultWriter:
 
         Collective.
         """
-        t = float(inc.step)
+        from rough_contact.fem.interface_output import pseudo_time
+
+        self.load_factors.append(float(inc.load_factor))
+        t = float(pseudo_time(self.load_factors)[-1])
         if self.u is not None:
             self._write_displacement(t)
-        if self.point_data is not None:
-            self._write_points(inc.step, t)
+        if self.interface_writer is not None:
+            self.interface_writer.write(inc.load_factor, t)
         self._write_csv(inc, extra)

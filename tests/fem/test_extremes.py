@@ -269,7 +269,7 @@ class Scene:
             return res
 
         solver.solve = counting_solve
-        writer = ResultWriter(outdir, comm, u=None, point_data=None,
+        writer = ResultWriter(outdir, comm, u=None,
                               extra_columns=("force_error_rel",))
         out = Outcome(case=case, converged=False)
         min_p, min_d, max_p, max_d = np.inf, np.inf, 0.0, 0.0
