@@ -1,0 +1,692 @@
+"""Normal (and tangential) interface law of a rough surface computed by boundary elements.
+
+The statistical laws (:mod:`rough_contact.population`) sum independent asperities; this module
+solves the *exact* frictionless contact of the measured or synthetic height map against a rigid
+flat on a periodic elastic half-space (FFT boundary elements) at a sequence of mean pressures, and
+tabulates the result as a :class:`~rough_contact.interface.normal.NormalLaw` (built by
+``NormalLaw.from_table``: same contract, same evaluation, same continuation rules), so the FE
+layer uses it unchanged. See ``docs/bem.md`` for the derivations and the verification.
+
+Quantities (all per unit nominal area; internal units mm, N, MPa):
+
+* separation ``h = d`` [mm]: the distance from the rigid flat to the mean plane of the
+  *undeformed* height map, the same meaning as the statistical laws' h. In the periodic
+  half-space the uniform (q = 0) part of the elastic displacement is undetermined; it is set to
+  zero (the FE bodies carry the macroscopic deformation), so in elastic contact d equals the mean
+  gap between the flat and the deformed surface. With the gap g(x) = d + u(x) - z(x),
+  d = mean over the elastic contact points of z - u.
+* pressure ``p`` [MPa]: mean contact pressure (the load per nominal area).
+* area fraction ``a = A/A0`` [-]: fraction of pixels carrying pressure (pixel counting).
+* normal stiffness ``k = -dp/dh`` [MPa/mm]: computed from each solution by Barber's relation:
+  with the contact set C (elastic contact points) frozen, an approach dh moves every point of C
+  by dh, so k = mean(dp) where dp, supported on C, solves (K dp)|_C = 1 (K the half-space
+  operator). For elastic contact this is the exact derivative of p(h) (changes of C are of higher
+  order because the pressure vanishes continuously at its edge); it is checked against finite
+  differences of p(h) in the tests. The table's k is the derivative of its interpolant; the build
+  reports the largest difference to the BEM k (``info["table_k_error"]``).
+* tangential stiffnesses ``kT_x, kT_y`` [MPa/mm]: the same incremental problem for a uniform
+  tangential displacement with every contact point in stick (Mindlin's assumption, no slip
+  annulus), with the periodic Cerruti kernel. Valid for two bodies of the same Poisson ratio and
+  modulus (Dundurs' beta = 0: no normal-tangential coupling) or a rigid counter-body; the ratio
+  kT/kN is compared with Mindlin's 2(1 - nu)/(2 - nu) for a circular contact.
+
+Elastic and saturated variants: ``hardness=None`` solves the elastic problem (0 <= p); a hardness
+H caps the pressure, 0 <= p <= H (perfectly plastic, "saturated" contact: points at H may
+interpenetrate the flat, which models material flattened away; volume is not conserved). In the
+saturated case d = mean over the elastic (0 < p < H) contact points of z - u, and k is the
+derivative with the saturated and open sets frozen.
+
+Backends (``backend=``): ``"tamaas"`` (default) uses Tamaas (``pip install rough_contact[bem]``;
+Polonsky-Keer-Rey for elastic, Kato's saturated solver for a hardness) for the contact solves;
+``"numpy"`` is this module's own Polonsky-Keer constrained conjugate gradient (with a pressure cap
+for the saturated case), the reference implementation and the fallback where Tamaas is absent.
+Both use the same half-space operator (Tamaas' basic_2d displacement equals ``2 p(q)/(E* |q|)``
+to round-off, checked in the tests); the post-processing (d, A/A0, k, kT) is this module's for
+both. The backend that ran is recorded in every result (``BEMCurves.backend``, ``info``).
+
+Pure module: numpy and scipy (tamaas imported lazily); no dolfinx, petsc4py, mpi4py.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import os
+import time
+import warnings
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Dict, Mapping, Optional, Protocol, Sequence, Tuple
+
+import numpy as np
+from scipy.fft import irfft2 as _irfft2, rfft2 as _rfft2
+
+from rough_contact.interface.normal import NormalLaw
+from rough_contact.surface import SpectralMoments, moments_from_height_map
+from rough_contact.validation import check_scalar
+
+__all__ = [
+    "BEMCurves", "BEMLaw", "BackendUnavailableError", "HeightMapWarning",
+    "available_backends", "bem_curves", "bem_normal_law", "bem_law_from_moments",
+    "check_height_map", "spacing_from_coordinates", "mindlin_ratio", "law_ratios",
+    "agreement_range", "default_cache_dir",
+    "MIN_PIXELS_PER_CORRELATION", "WARN_PIXELS_PER_CORRELATION", "WARN_RMS_SLOPE",
+    "MAX_RMS_SLOPE",
+]
+
+# ----------------------------------------------------------------------------------------------
+# limits of the input checks (documented in docs/bem.md)
+# ----------------------------------------------------------------------------------------------
+#: below this many pixels per correlation length the map resolves no asperity: ValueError
+MIN_PIXELS_PER_CORRELATION = 2.0
+#: below this many a warning (the grid-convergence study in docs/bem.md)
+WARN_PIXELS_PER_CORRELATION = 8.0
+#: rms slope above which the small-slope (linear half-space) assumption is strained: warning
+WARN_RMS_SLOPE = 0.1
+#: rms slope above which the half-space BEM is meaningless here: ValueError
+MAX_RMS_SLOPE = 0.5
+
+_CACHE_VERSION = 1
+_BACKENDS = ("tamaas", "numpy")
+
+
+class BackendUnavailableError(ImportError):
+    """The requested BEM backend cannot be imported (e.g. Tamaas not installed)."""
+
+
+class HeightMapWarning(UserWarning):
+    """A height map that the BEM can solve but whose result should be doubted."""
+
+
+def available_backends() -> Tuple[str, ...]:
+    """Names of the backends that can run here ("numpy" always; "tamaas" when installed)."""
+    out = []
+    try:
+        _import_tamaas()
+        out.append("tamaas")
+    except BackendUnavailableError:
+        pass
+    out.append("numpy")
+    return tuple(out)
+
+
+def _import_tamaas():
+    try:
+        import tamaas  # noqa: F401  (optional extra rough_contact[bem])
+    except ImportError as e:
+        raise BackendUnavailableError(
+            "the BEM backend 'tamaas' is not installed (it is the optional extra "
+            "rough_contact[bem]: `RC_EXTRAS=bem bash run.sh setup`, or `pip install -c "
+            ".venv/constraints.txt tamaas==2.8.1`); pass backend='numpy' for this package's "
+            f"own, slower reference solver ({e})") from None
+    return tamaas
+
+
+# ----------------------------------------------------------------------------------------------
+# input checks
+# ----------------------------------------------------------------------------------------------
+def spacing_from_coordinates(x, y, rtol: float = 1e-3) -> Tuple[float, float]:
+    """Sampling steps (dx, dy) [mm] of a height map from its coordinate vectors.
+
+    Args:
+        x: (nx,) coordinates along axis 0 [mm], strictly monotone and uniformly spaced.
+        y: (ny,) coordinates along axis 1 [mm], likewise.
+        rtol: largest accepted deviation of a step from the mean step (relative).
+
+    Raises:
+        ValueError: fewer than 2 coordinates, non-finite values, or non-uniform spacing (the FFT
+            half-space operator needs a uniform grid: resample the map first).
+    """
+    out = []
+    for name, c in (("x", x), ("y", y)):
+        c = np.asarray(c, dtype=float).ravel()
+        if c.size < 2 or not np.isfinite(c).all():
+            raise ValueError(f"coordinates {name} must hold >= 2 finite values, got {c.size} "
+                             f"({int((~np.isfinite(c)).sum())} non-finite)")
+        d = np.diff(c)
+        step = float(np.mean(d))
+        dev = np.abs(d - step) / abs(step) if step != 0 else np.full(d.shape, np.inf)
+        if step <= 0 or dev.max() > rtol:
+            j = int(np.argmax(dev))
+            raise ValueError(
+                f"non-uniform spacing along {name}: step {name}[{j + 1}] - {name}[{j}] = "
+                f"{d[j]!r} mm deviates by {dev[j]:.3g} (relative) from the mean step {step!r} "
+                f"mm; valid: strictly increasing, uniform to rtol = {rtol:g} (resample the map "
+                "onto a uniform grid)")
+        out.append(step)
+    return out[0], out[1]
+
+
+def _correlation_lengths(z: np.ndarray) -> Tuple[float, float]:
+    """Correlation lengths along both axes in pixels: first lag where the ACF falls below 1/e."""
+    Z = _rfft2(z)
+    acf = _irfft2(np.abs(Z) ** 2, s=z.shape)
+    acf /= acf[0, 0]
+    out = []
+    for line in (acf[: z.shape[0] // 2 + 1, 0], acf[0, : z.shape[1] // 2 + 1]):
+        below = np.flatnonzero(line < math.exp(-1.0))
+        if below.size == 0:
+            out.append(float(line.size))       # longer than half the map
+            continue
+        j = int(below[0])
+        # linear interpolation between lags j-1 and j
+        f0, f1 = line[j - 1], line[j]
+        out.append(float(j - 1 + (f0 - math.exp(-1.0)) / (f0 - f1)))
+    return out[0], out[1]
+
+
+@dataclass(frozen=True)
+class MapDiagnostics:
+    """What :func:`check_height_map` measured (pixels, mm, -)."""
+
+    shape: Tuple[int, int]
+    spacing: Tuple[float, float]
+    rms_height: float
+    rms_slope: float
+    correlation_pixels: Tuple[float, float]
+    edge_mismatch: float
+
+
+def check_height_map(z, dx: float, dy: Optional[float] = None, *,
+                     boundary: str = "periodic") -> Tuple[np.ndarray, MapDiagnostics]:
+    """Validate a height map for the BEM and return it prepared (mean removed, contiguous).
+
+    Args:
+        z: (nx, ny) heights [mm], axis 0 = x (grain direction), nx, ny >= 8.
+        dx, dy: uniform sampling steps [mm] (dy defaults to dx); use
+            :func:`spacing_from_coordinates` for a map given with coordinates.
+        boundary: "periodic" (the map is one period), "mirror" (a measured, non-periodic map:
+            extended by even reflection to 2nx x 2ny, continuous and periodic, 4x the cost) or
+            "window" (the heights are tapered to the mean plane over the outer 1/8 of each side
+            by a Tukey window: cheaper, but the edge strips carry less load).
+
+    Returns:
+        (heights prepared for the solver [mm], :class:`MapDiagnostics` of the input map).
+
+    Raises:
+        ValueError: not 2D or too small, NaN/inf heights (fill or crop unmeasured points
+            first), bad steps or boundary, fewer than ``MIN_PIXELS_PER_CORRELATION`` pixels per
+            correlation length, an rms slope above ``MAX_RMS_SLOPE``, a flat map.
+
+    Warns:
+        HeightMapWarning: fewer than ``WARN_PIXELS_PER_CORRELATION`` pixels per correlation
+            length, an rms slope above ``WARN_RMS_SLOPE`` (small-slope assumption strained), or
+            a "periodic" map whose opposite edges do not match (use boundary="mirror").
+    """
+    z = np.asarray(z, dtype=float)
+    if z.ndim != 2 or min(z.shape) < 8:
+        raise ValueError(f"height map shape {z.shape} is invalid: a 2D map of at least 8 x 8 "
+                         "pixels is needed")
+    bad = ~np.isfinite(z)
+    if bad.any():
+        i, j = np.argwhere(bad)[0]
+        raise ValueError(
+            f"height map has {int(bad.sum())} NaN/inf values out of {z.size} (first at pixel "
+            f"({i}, {j})); valid: all heights finite. Fill unmeasured points (e.g. "
+            "interpolation) or crop the map before the BEM")
+    dx = check_scalar("dx", dx, lo=0.0, unit="mm")
+    dy = dx if dy is None else check_scalar("dy", dy, lo=0.0, unit="mm")
+    if boundary not in ("periodic", "mirror", "window"):
+        raise ValueError(f"boundary = {boundary!r} is invalid; valid: 'periodic', 'mirror', "
+                         "'window'")
+    z = z - z.mean()
+    rq = float(np.sqrt(np.mean(z ** 2)))
+    if not rq > 0:
+        raise ValueError("height map is flat (rms height 0 mm): nothing to compute")
+    # rms slope by central differences inside the map (no wrap: valid for non-periodic maps)
+    gx = (z[2:, 1:-1] - z[:-2, 1:-1]) / (2 * dx)
+    gy = (z[1:-1, 2:] - z[1:-1, :-2]) / (2 * dy)
+    slope = float(np.sqrt(np.mean(gx ** 2) + np.mean(gy ** 2)))
+    cx, cy = _correlation_lengths(z)
+    # mismatch of the periodic continuation: rms jump across the opposite edges relative to the
+    # rms jump between interior neighbours
+    jump = np.sqrt(0.5 * (np.mean((z[0] - z[-1]) ** 2) + np.mean((z[:, 0] - z[:, -1]) ** 2)))
+    inner = np.sqrt(0.5 * (np.mean(np.diff(z, axis=0) ** 2) + np.mean(np.diff(z, axis=1) ** 2)))
+    mismatch = float(jump / inner) if inner > 0 else 0.0
+    diag = MapDiagnostics(z.shape, (dx, dy), rq, slope, (cx, cy), mismatch)
+    cmin = min(cx, cy)
+    if cmin < MIN_PIXELS_PER_CORRELATION:
+        raise ValueError(
+            f"correlation length = {cmin:.3g} pixels (x: {cx:.3g}, y: {cy:.3g}) is below "
+            f"MIN_PIXELS_PER_CORRELATION = {MIN_PIXELS_PER_CORRELATION:g}: the map does not "
+            "resolve its asperities (noise-like heights); measure or resample with a finer step")
+    if cmin < WARN_PIXELS_PER_CORRELATION:
+        warnings.warn(
+            f"correlation length = {cmin:.3g} pixels (x: {cx:.3g}, y: {cy:.3g}) < "
+            f"{WARN_PIXELS_PER_CORRELATION:g}: contact spots are under-resolved and the BEM law "
+            "is grid-dependent (see the grid-convergence study in docs/bem.md)",
+            HeightMapWarning, stacklevel=2)
+    if slope > MAX_RMS_SLOPE:
+        raise ValueError(
+            f"rms slope = {slope:.3g} is above MAX_RMS_SLOPE = {MAX_RMS_SLOPE:g}: the half-space "
+            "boundary elements assume small slopes; this surface is too rough for them (check "
+            "units and detrending: heights and steps both in mm)")
+    if slope > WARN_RMS_SLOPE:
+        warnings.warn(
+            f"rms slope = {slope:.3g} > {WARN_RMS_SLOPE:g}: the small-slope assumption of the "
+            "half-space boundary elements is strained (errors of the order of the slope squared)",
+            HeightMapWarning, stacklevel=2)
+    if boundary == "periodic" and mismatch > 3.0:
+        warnings.warn(
+            f"the map is not periodic: the jump across opposite edges is {mismatch:.3g} times "
+            "the rms jump between neighbouring pixels, so the periodic BEM sees an artificial "
+            "ridge along the edges; use boundary='mirror' (or 'window') for a measured map",
+            HeightMapWarning, stacklevel=2)
+    if boundary == "mirror":
+        z = np.concatenate([z, z[::-1]], axis=0)
+        z = np.concatenate([z, z[:, ::-1]], axis=1)
+    elif boundary == "window":
+        z = z * np.outer(_tukey(z.shape[0]), _tukey(z.shape[1]))
+        z = z - z.mean()
+    return np.ascontiguousarray(z), diag
+
+
+def _tukey(n: int, frac: float = 0.25) -> np.ndarray:
+    """Tukey window (flat top, cosine tapers over frac/2 of the length at each end)."""
+    w = np.ones(n)
+    m = max(int(frac * n / 2), 1)
+    ramp = 0.5 * (1 - np.cos(np.pi * (np.arange(m) + 0.5) / m))
+    w[:m] = ramp
+    w[-m:] = ramp[::-1]
+    return w
+
+
+# ----------------------------------------------------------------------------------------------
+# the half-space operator and the solvers
+# ----------------------------------------------------------------------------------------------
+class HalfSpace:
+    """Periodic elastic half-space: surface displacement from surface tractions by FFT.
+
+    Normal: u(q) = 2 p(q) / (E* |q|); tangential (Cerruti, both bodies with the same nu, or one
+    rigid): u_i(q) = 2 / (E* |q| (1 - nu)) (delta_ij - nu q_i q_j / |q|^2) t_j(q). The q = 0 mode
+    (uniform displacement) is set to zero: it is the mean separation's job.
+
+    Args:
+        shape: (nx, ny) pixels; size: (Lx, Ly) [mm]; E_star [MPa]; nu [-].
+    """
+
+    def __init__(self, shape: Tuple[int, int], size: Tuple[float, float], E_star: float,
+                 nu: float):
+        self.shape = (int(shape[0]), int(shape[1]))
+        self.size = (float(size[0]), float(size[1]))
+        nx, ny = self.shape
+        qx = 2 * np.pi * np.fft.fftfreq(nx, self.size[0] / nx)[:, None]
+        qy = 2 * np.pi * np.fft.rfftfreq(ny, self.size[1] / ny)[None, :]
+        q = np.hypot(qx, qy)
+        q[0, 0] = 1.0
+        self._g = 2.0 / (E_star * q)
+        self._g[0, 0] = 0.0
+        ct = 1.0 / (1.0 - nu)
+        self._gxx = self._g * ct * (1.0 - nu * (qx / q) ** 2)
+        self._gyy = self._g * ct * (1.0 - nu * (qy / q) ** 2)
+        self._gxy = -self._g * ct * nu * qx * qy / q ** 2
+
+    def normal(self, p: np.ndarray) -> np.ndarray:
+        """Zero-mean normal displacement [mm] of the pressure field p (nx, ny) [MPa]."""
+        return _irfft2(self._g * _rfft2(p), s=self.shape)
+
+    def tangential(self, tx: np.ndarray, ty: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
+        """Zero-mean tangential displacements [mm] of the shear tractions tx, ty [MPa]."""
+        X, Y = _rfft2(tx), _rfft2(ty)
+        ux = _irfft2(self._gxx * X + self._gxy * Y, s=self.shape)
+        uy = _irfft2(self._gxy * X + self._gyy * Y, s=self.shape)
+        return ux, uy
+
+
+class ContactSolver(Protocol):
+    """A backend: mean pressure -> pressure field of the rigid-flat contact of the height map."""
+
+    name: str
+
+    def solve(self, mean_pressure: float, initial: Optional[np.ndarray]) -> np.ndarray:
+        """Pressure field (nx, ny) [MPa] with mean ``mean_pressure``; ``initial`` a start guess."""
+
+
+class NumpySolver:
+    """Polonsky & Keer (1999) constrained conjugate gradient, with an optional pressure cap.
+
+    The free set is {0 < p < H}; points at p = 0 that overlap the flat and points at p = H whose
+    gap opens are released into it (the conjugacy is then reset, as in Polonsky-Keer), and the
+    load is restored by scaling the pressure (capped at H). Converged when the rms gap on the free
+    set and the largest complementarity violation are below ``tol`` times the rms height.
+    """
+
+    def __init__(self, z: np.ndarray, halfspace: HalfSpace, hardness: Optional[float],
+                 tol: float = 1e-8, max_iter: int = 20000):
+        self.z = z
+        self.K = halfspace
+        self.H = np.inf if hardness is None else float(hardness)
+        self.tol = tol
+        self.max_iter = max_iter
+        self.name = "numpy Polonsky-Keer" + ("" if hardness is None else " (saturated)")
+        self.iterations = 0
+
+    def _restore(self, p: np.ndarray, target: float) -> np.ndarray:
+        """Scale the unsaturated pressures so that the mean is ``target`` (capped at H)."""
+        if not np.isfinite(self.H):
+            return p * (target / p.mean())
+        sat = p >= self.H
+        fixed = self.H * np.count_nonzero(sat) / p.size
+        free = np.where(sat, 0.0, p)
+        m = free.mean()
+        if m <= 0:
+            return p
+        s = max((target - fixed) / m, 0.0)
+        # mean(min(s p_free, H)) + fixed = target: concave and increasing in s, Newton from below
+        # (the uncapped value) converges monotonically
+        for _ in range(100):
+            sp = s * free
+            under = sp < self.H
+            f = np.minimum(sp, self.H).mean() + fixed - target
+            df = (free * under).mean()
+            if abs(f) <= 1e-14 * target or df <= 0:
+                break
+            s -= f / df
+        return np.where(sat, self.H, np.minimum(s * free, self.H))
+
+    def solve(self, mean_pressure: float, initial: Optional[np.ndarray] = None) -> np.ndarray:
+        z, H = self.z, self.H
+        zr = float(np.sqrt(np.mean(z ** 2)))
+        if initial is None:
+            p = np.full(z.shape, mean_pressure)
+        else:
+            p = self._restore(np.maximum(initial, 1e-300 * mean_pressure), mean_pressure)
+        t = np.zeros_like(z)
+        g_old = 1.0
+        delta = 0.0
+        for it in range(1, self.max_iter + 1):
+            g = self.K.normal(p) - z
+            S = (p > 0) & (p < H)
+            if not S.any():     # every contact point saturated: nothing left to iterate
+                break
+            g -= g[S].mean()
+            G = float(np.dot(g[S], g[S]))
+            t = np.where(S, g + (delta * G / g_old) * t, 0.0)
+            g_old = G
+            r = self.K.normal(t)
+            r -= r[S].mean()
+            den = float(np.dot(r[S], t[S]))
+            tau = float(np.dot(g[S], t[S])) / den if den > 0 else 0.0
+            p = np.where(S, p - tau * t, p)
+            clipped = (p < 0) | (p > H)
+            p = np.clip(p, 0.0, H)
+            over = (p == 0) & (g < 0)          # open points overlapping the flat
+            opened = (p == H) & (g > 0) & ~S   # saturated points whose gap opened
+            rel = over | opened
+            delta = 0.0 if (rel.any() or clipped.any()) else 1.0
+            p = np.where(rel, np.clip(p - tau * g, 0.0, H), p)
+            p = self._restore(p, mean_pressure)
+            # convergence: rms gap on the free set and complementarity violations
+            res = math.sqrt(G / max(int(S.sum()), 1)) / zr
+            viol = max(float(-g[(p == 0)].min(initial=0.0)),
+                       float(g[(p == H)].max(initial=0.0))) / zr
+            if res < self.tol and viol < 10 * self.tol:
+                break
+        else:
+            raise RuntimeError(f"numpy BEM solver did not converge in {self.max_iter} iterations "
+                               f"(residual {res:.3g}, violation {viol:.3g}, tol {self.tol:g})")
+        self.iterations = it
+        return p
+
+
+class TamaasSolver:
+    """Tamaas' PolonskyKeerRey (elastic) or KatoSaturated (hardness cap) on the same grid."""
+
+    def __init__(self, z: np.ndarray, size: Tuple[float, float], E_star: float, nu: float,
+                 hardness: Optional[float], tol: float = 1e-10):
+        tm = _import_tamaas()
+        tm.set_log_level(tm.LogLevel.error)
+        self._surface = np.ascontiguousarray(z, dtype=float)   # tamaas keeps a reference
+        self._model = tm.ModelFactory.createModel(tm.model_type.basic_2d, list(size),
+                                                  list(z.shape))
+        # basic_2d uses the plane modulus E/(1 - nu^2) = E*: set E so that it equals E_star
+        self._model.E = E_star * (1.0 - nu ** 2)
+        self._model.nu = nu
+        if hardness is None:
+            self._solver = tm.PolonskyKeerRey(self._model, self._surface, tol)
+            kind = "PolonskyKeerRey"
+        else:
+            self._solver = tm.KatoSaturated(self._model, self._surface, tol, float(hardness))
+            kind = "KatoSaturated"
+        self.name = f"tamaas {tm.__version__} {kind}"
+        self.iterations = -1
+
+    def solve(self, mean_pressure: float, initial: Optional[np.ndarray] = None) -> np.ndarray:
+        # tamaas starts from its current traction field: the previous load step
+        self._solver.solve(float(mean_pressure))
+        return np.array(self._model.traction, dtype=float)
+
+
+def _cg_on_set(apply, mask: np.ndarray, rhs: Sequence[np.ndarray], tol: float = 1e-10,
+               max_iter: int = 5000) -> Tuple[np.ndarray, ...]:
+    """Conjugate gradients for P A P x = P b with x supported on mask (A symmetric PD there).
+
+    ``apply`` maps a tuple of fields to a tuple of fields (block operator).
+    """
+    x = tuple(np.zeros_like(b) for b in rhs)
+    r = tuple(np.where(mask, b, 0.0) for b in rhs)
+    d = r
+    rr = sum(float(np.dot(ri.ravel(), ri.ravel())) for ri in r)
+    r0 = math.sqrt(rr)
+    for _ in range(max_iter):
+        if math.sqrt(rr) <= tol * r0:
+            return x
+        Ad = tuple(np.where(mask, a, 0.0) for a in apply(d))
+        alpha = rr / sum(float(np.dot(di.ravel(), ai.ravel())) for di, ai in zip(d, Ad))
+        x = tuple(xi + alpha * di for xi, di in zip(x, d))
+        r = tuple(ri - alpha * ai for ri, ai in zip(r, Ad))
+        rr_new = sum(float(np.dot(ri.ravel(), ri.ravel())) for ri in r)
+        d = tuple(ri + (rr_new / rr) * di for ri, di in zip(r, d))
+        rr = rr_new
+    raise RuntimeError(f"stiffness CG did not converge in {max_iter} iterations "
+                       f"(residual {math.sqrt(rr) / r0:.3g})")
+
+
+def _post_process(z: np.ndarray, p: np.ndarray, K: HalfSpace, hardness: Optional[float],
+                  tangential: bool) -> Tuple[float, float, float, float, float]:
+    """d [mm], A/A0, k [MPa/mm], kT_x, kT_y [MPa/mm] of one solved pressure field."""
+    H = np.inf if hardness is None else hardness
+    r = z - K.normal(p)                   # gap = d - r
+    contact = p > 0
+    elastic = contact & (p < H * (1 - 1e-12))
+    if elastic.any():
+        d = float(r[elastic].mean())
+    else:   # all contact points saturated: d between the open and the saturated bounds
+        lo = float(r[~contact].max(initial=-np.inf))
+        hi = float(r[contact].min(initial=np.inf))
+        d = 0.5 * (lo + hi) if np.isfinite(lo + hi) else (lo if np.isfinite(lo) else hi)
+    a = float(contact.mean())
+    if a >= 1.0:
+        raise ValueError("full contact (A/A0 = 1): the mean pressure is above the range of the "
+                         "rough-contact law; lower the largest pressure")
+    if elastic.any():
+        (dp,) = _cg_on_set(lambda f: (K.normal(f[0]),), elastic, (np.ones_like(z),))
+        k = float(dp.mean())
+    else:
+        k = 0.0
+    kx = ky = float("nan")
+    if tangential:
+        one, zero = np.ones_like(z), np.zeros_like(z)
+        tx, _ = _cg_on_set(lambda f: K.tangential(f[0], f[1]), contact, (one, zero))
+        _, ty = _cg_on_set(lambda f: K.tangential(f[0], f[1]), contact, (zero, one))
+        kx, ky = float(tx.mean()), float(ty.mean())
+    return d, a, k, kx, ky
+
+
+# ----------------------------------------------------------------------------------------------
+# results
+# ----------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class BEMCurves:
+    """BEM results of one or more height maps (realisations) at the same mean pressures.
+
+    Attributes:
+        pressure: (n_p,) mean pressures solved [MPa], increasing.
+        separation: (n_r, n_p) separation d of the mean plane [mm].
+        area_fraction: (n_r, n_p) A/A0 [-].
+        stiffness: (n_r, n_p) normal stiffness k = -dp/dh [MPa/mm] (Barber).
+        tangential_stiffness: (n_r, n_p, 2) kT_x, kT_y in full stick [MPa/mm] (NaN if skipped).
+        backend: name of the solver that ran (e.g. "tamaas 2.8.1 PolonskyKeerRey").
+        grid: (nx, ny) pixels solved (after mirroring), size: (Lx, Ly) [mm].
+        E_star [MPa], nu [-], hardness [MPa] or None (elastic).
+        rms_height: (n_r,) rms height of each map [mm]; build_time: (n_r,) wall time [s].
+        cached: (n_r,) True where the result came from the disk cache.
+    """
+
+    pressure: np.ndarray
+    separation: np.ndarray
+    area_fraction: np.ndarray
+    stiffness: np.ndarray
+    tangential_stiffness: np.ndarray
+    backend: str
+    grid: Tuple[int, int]
+    size: Tuple[float, float]
+    E_star: float
+    nu: float
+    hardness: Optional[float]
+    rms_height: np.ndarray
+    build_time: np.ndarray
+    cached: np.ndarray
+
+    @property
+    def n_realisations(self) -> int:
+        return int(self.separation.shape[0])
+
+    @staticmethod
+    def stack(curves: Sequence["BEMCurves"]) -> "BEMCurves":
+        """Join single-map results computed at the same pressures into one."""
+        c0 = curves[0]
+        for c in curves[1:]:
+            if not np.array_equal(c.pressure, c0.pressure):
+                raise ValueError("curves were computed at different pressures")
+        cat = lambda name: np.concatenate([getattr(c, name) for c in curves])  # noqa: E731
+        return replace(c0, separation=cat("separation"), area_fraction=cat("area_fraction"),
+                       stiffness=cat("stiffness"),
+                       tangential_stiffness=cat("tangential_stiffness"),
+                       rms_height=cat("rms_height"), build_time=cat("build_time"),
+                       cached=cat("cached"))
+
+
+def default_cache_dir() -> Path:
+    """``$ROUGH_CONTACT_CACHE`` or ``~/.cache/rough_contact/bem``."""
+    env = os.environ.get("ROUGH_CONTACT_CACHE")
+    return Path(env) if env else Path.home() / ".cache" / "rough_contact" / "bem"
+
+
+def _cache_key(z: np.ndarray, size, E_star, nu, hardness, pressures, backend, tol,
+               tangential) -> str:
+    h = hashlib.sha256()
+    h.update(np.ascontiguousarray(z, dtype=np.float64).tobytes())
+    meta = dict(v=_CACHE_VERSION, shape=list(z.shape), size=[float(s) for s in size],
+                E_star=float(E_star), nu=float(nu),
+                hardness=None if hardness is None else float(hardness),
+                pressures=[float(p) for p in pressures], backend=backend, tol=float(tol),
+                tangential=bool(tangential))
+    h.update(json.dumps(meta, sort_keys=True).encode())
+    return h.hexdigest()[:32]
+
+
+def _check_pressures(pressures, hardness) -> np.ndarray:
+    p = np.array(pressures, dtype=float).ravel()
+    if p.size < 3:
+        raise ValueError(f"pressures must hold >= 3 values, got {p.size}")
+    if not np.isfinite(p).all() or (p <= 0).any():
+        raise ValueError(f"pressures = {p!r} MPa are invalid: all must be finite and > 0")
+    if np.any(np.diff(p) <= 0):
+        raise ValueError("pressures must be strictly increasing")
+    if hardness is not None and p[-1] >= hardness:
+        raise ValueError(f"largest pressure = {p[-1]!r} MPa is invalid: it must be below the "
+                         f"hardness H = {hardness!r} MPa (p = H is full plastic contact)")
+    return p
+
+
+def _solver(backend: str, z, size, E_star, nu, hardness, tol):
+    if backend == "tamaas":
+        return TamaasSolver(z, size, E_star, nu, hardness, tol)
+    if backend == "numpy":
+        return NumpySolver(z, HalfSpace(z.shape, size, E_star, nu), hardness, tol)
+    raise ValueError(f"backend = {backend!r} is invalid; valid: {_BACKENDS}")
+
+
+def bem_curves(z, dx: float, dy: Optional[float] = None, *, E_star: float, nu: float,
+               pressures, hardness: Optional[float] = None, backend: str = "tamaas",
+               boundary: str = "periodic", tol: Optional[float] = None,
+               tangential: bool = True, cache: bool = True,
+               cache_dir: Optional[os.PathLike] = None) -> BEMCurves:
+    """Solve the rough contact of one height map at the given mean pressures.
+
+    Args:
+        z: (nx, ny) heights [mm], axis 0 = x; see :func:`check_height_map` for the checks.
+        dx, dy: sampling steps [mm].
+        E_star: effective modulus E* [MPa]; nu: Poisson ratio of the bodies [-] (tangential
+            kernel only).
+        pressures: (n_p,) mean pressures [MPa], increasing, >= 3 values.
+        hardness: None (elastic) or the pressure cap H [MPa] (saturated contact).
+        backend: "tamaas" (default; needs the extra) or "numpy".
+        boundary: "periodic", "mirror" or "window" (:func:`check_height_map`).
+        tol: solver tolerance (default 1e-10 for tamaas, 1e-8 for numpy, both relative).
+        tangential: also compute the stick tangential stiffnesses (about doubles the cost).
+        cache: read/write the result in the disk cache (keyed by the prepared heights, the grid,
+            E*, nu, H, the pressures, the backend, tol and the code version).
+        cache_dir: cache directory (default :func:`default_cache_dir`).
+
+    Returns:
+        :class:`BEMCurves` with one realisation.
+
+    Raises:
+        ValueError: bad map (see :func:`check_height_map`) or parameters, full contact.
+        BackendUnavailableError: the backend cannot be imported.
+    """
+    E_star = check_scalar("E_star", E_star, lo=0.0, unit="MPa")
+    nu = check_scalar("nu", nu, lo=-1.0, hi=0.5, hi_open=False)
+    if hardness is not None:
+        hardness = check_scalar("hardness", hardness, lo=0.0, unit="MPa")
+    pressures = _check_pressures(pressures, hardness)
+    if backend not in _BACKENDS:
+        raise ValueError(f"backend = {backend!r} is invalid; valid: {_BACKENDS}")
+    if backend == "tamaas":
+        _import_tamaas()
+    tol = (1e-10 if backend == "tamaas" else 1e-8) if tol is None else \
+        check_scalar("tol", tol, lo=0.0, hi=1e-2)
+    zp, diag = check_height_map(z, dx, dy, boundary=boundary)
+    dx, dy = diag.spacing
+    size = (zp.shape[0] * dx, zp.shape[1] * dy)
+    key = _cache_key(zp, size, E_star, nu, hardness, pressures, backend, tol, tangential)
+    path = Path(cache_dir or default_cache_dir()) / f"bem_{key}.npz"
+    if cache and path.exists():
+        with np.load(path, allow_pickle=False) as f:
+            meta = json.loads(str(f["meta"]))
+            return BEMCurves(pressure=pressures, separation=f["separation"][None],
+                             area_fraction=f["area_fraction"][None],
+                             stiffness=f["stiffness"][None],
+                             tangential_stiffness=f["tangential_stiffness"][None],
+                             backend=meta["backend"], grid=tuple(zp.shape), size=size,
+                             E_star=E_star, nu=nu, hardness=hardness,
+                             rms_height=np.array([diag.rms_height]),
+                             build_time=np.array([meta["build_time"]]),
+                             cached=np.array([True]))
+    t0 = time.perf_counter()
+    solver = _solver(backend, zp, size, E_star, nu, hardness, tol)
+    K = HalfSpace(zp.shape, size, E_star, nu)
+    n = pressures.size
+    d, a, k = np.empty(n), np.empty(n), np.empty(n)
+    kt = np.full((n, 2), np.nan)
+    p_field = None
+    for j, pm in enumerate(pressures):
+        p_field = solver.solve(pm, p_field)
+        d[j], a[j], k[j], kt[j, 0], kt[j, 1] = _post_process(zp, p_field, K, hardness,
+                                                             tangential)
+    elapsed = time.perf_counter() - t0
+    out = BEMCurves(pressure=pressures, separation=d[None], area_fraction=a[None],
+                    stiffness=k[None], tangential_stiffness=kt[None], backend=solver.name,
+                    grid=tuple(zp.shape), size=size, E_star=E_star, nu=nu, hardness=hardness,
+                    rms_height=np.array([diag.rms_height]), build_time=np.array([elapsed]),
+                    cached=np.array([False]))
+    if cache:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_name(path.name + f".{os.getpid()}.tmp.npz")
+        np.savez(tmp, separation=d, area_fraction=a, stiffness=k, tangential_stiffness=kt,
+                 meta=json.dumps({"backend": solver.name, "build_time": elapsed}))
+        os.replace(tmp, path)   # atomic: a concurrent reader never sees half a file
+    return out
