@@ -70,7 +70,8 @@ __all__ = [
     "BEMCurves", "BEMLaw", "BackendUnavailableError", "HeightMapWarning",
     "available_backends", "bem_curves", "bem_normal_law", "bem_law_from_moments",
     "check_height_map", "spacing_from_coordinates", "mindlin_ratio", "law_ratios",
-    "agreement_range", "default_cache_dir",
+    "agreement_range", "default_cache_dir", "default_pressures", "law_from_curves",
+    "HalfSpace", "NumpySolver", "TamaasSolver", "MapDiagnostics",
     "MIN_PIXELS_PER_CORRELATION", "WARN_PIXELS_PER_CORRELATION", "WARN_RMS_SLOPE",
     "MAX_RMS_SLOPE",
 ]
@@ -346,60 +347,38 @@ class ContactSolver(Protocol):
 class NumpySolver:
     """Polonsky & Keer (1999) constrained conjugate gradient, with an optional pressure cap.
 
-    The free set is {0 < p < H}; points at p = 0 that overlap the flat and points at p = H whose
-    gap opens are released into it (the conjugacy is then reset, as in Polonsky-Keer), and the
-    load is restored by scaling the pressure (capped at H). Converged when the rms gap on the free
-    set and the largest complementarity violation are below ``tol`` times the rms height.
+    Elastic: the classical algorithm (conjugate gradients on the contact set, overlapping points
+    released into it with a conjugacy reset, the load restored by scaling). Saturated (pressure cap
+    H): an outer active-set loop around it; points at p = H are held at H (their displacement
+    moves into an effective surface), the elastic problem is solved on the remaining points, points
+    whose pressure exceeds H join the saturated set and saturated points whose gap opens leave it,
+    until the set is stable. Converged when the rms gap on the contact set and the largest
+    complementarity violation are below ``tol`` times the rms height.
     """
 
     def __init__(self, z: np.ndarray, halfspace: HalfSpace, hardness: Optional[float],
-                 tol: float = 1e-8, max_iter: int = 20000):
+                 tol: float = 1e-8, max_iter: int = 20000, max_outer: int = 200):
         self.z = z
         self.K = halfspace
-        self.H = np.inf if hardness is None else float(hardness)
+        self.H = None if hardness is None else float(hardness)
         self.tol = tol
         self.max_iter = max_iter
+        self.max_outer = max_outer
         self.name = "numpy Polonsky-Keer" + ("" if hardness is None else " (saturated)")
         self.iterations = 0
+        self._zr = float(np.sqrt(np.mean(z ** 2)))
 
-    def _restore(self, p: np.ndarray, target: float) -> np.ndarray:
-        """Scale the unsaturated pressures so that the mean is ``target`` (capped at H)."""
-        if not np.isfinite(self.H):
-            return p * (target / p.mean())
-        sat = p >= self.H
-        fixed = self.H * np.count_nonzero(sat) / p.size
-        free = np.where(sat, 0.0, p)
-        m = free.mean()
-        if m <= 0:
-            return p
-        s = max((target - fixed) / m, 0.0)
-        # mean(min(s p_free, H)) + fixed = target: concave and increasing in s, Newton from below
-        # (the uncapped value) converges monotonically
-        for _ in range(100):
-            sp = s * free
-            under = sp < self.H
-            f = np.minimum(sp, self.H).mean() + fixed - target
-            df = (free * under).mean()
-            if abs(f) <= 1e-14 * target or df <= 0:
-                break
-            s -= f / df
-        return np.where(sat, self.H, np.minimum(s * free, self.H))
-
-    def solve(self, mean_pressure: float, initial: Optional[np.ndarray] = None) -> np.ndarray:
-        z, H = self.z, self.H
-        zr = float(np.sqrt(np.mean(z ** 2)))
-        if initial is None:
-            p = np.full(z.shape, mean_pressure)
-        else:
-            p = self._restore(np.maximum(initial, 1e-300 * mean_pressure), mean_pressure)
+    def _pk(self, z: np.ndarray, load: float, allowed: Optional[np.ndarray],
+            p: np.ndarray) -> np.ndarray:
+        """Elastic Polonsky-Keer on the allowed points: mean(p) = load, p = 0 elsewhere."""
+        zr = self._zr
         t = np.zeros_like(z)
         g_old = 1.0
         delta = 0.0
+        res = viol = float("nan")
         for it in range(1, self.max_iter + 1):
             g = self.K.normal(p) - z
-            S = (p > 0) & (p < H)
-            if not S.any():     # every contact point saturated: nothing left to iterate
-                break
+            S = p > 0
             g -= g[S].mean()
             G = float(np.dot(g[S], g[S]))
             t = np.where(S, g + (delta * G / g_old) * t, 0.0)
@@ -408,26 +387,58 @@ class NumpySolver:
             r -= r[S].mean()
             den = float(np.dot(r[S], t[S]))
             tau = float(np.dot(g[S], t[S])) / den if den > 0 else 0.0
-            p = np.where(S, p - tau * t, p)
-            clipped = (p < 0) | (p > H)
-            p = np.clip(p, 0.0, H)
+            p = np.where(S, p - tau * t, 0.0)
+            np.maximum(p, 0.0, out=p)
             over = (p == 0) & (g < 0)          # open points overlapping the flat
-            opened = (p == H) & (g > 0) & ~S   # saturated points whose gap opened
-            rel = over | opened
-            delta = 0.0 if (rel.any() or clipped.any()) else 1.0
-            p = np.where(rel, np.clip(p - tau * g, 0.0, H), p)
-            p = self._restore(p, mean_pressure)
-            # convergence: rms gap on the free set and complementarity violations
+            if allowed is not None:
+                over &= allowed
+            delta = 0.0 if over.any() else 1.0
+            p[over] = -tau * g[over]
+            p *= load / p.mean()
             res = math.sqrt(G / max(int(S.sum()), 1)) / zr
-            viol = max(float(-g[(p == 0)].min(initial=0.0)),
-                       float(g[(p == H)].max(initial=0.0))) / zr
+            free = p == 0
+            if allowed is not None:
+                free &= allowed
+            viol = float(-g[free].min(initial=0.0)) / zr
             if res < self.tol and viol < 10 * self.tol:
-                break
+                self.iterations += it
+                return p
+        raise RuntimeError(f"numpy BEM solver did not converge in {self.max_iter} iterations "
+                           f"(residual {res:.3g}, violation {viol:.3g}, tol {self.tol:g})")
+
+    def solve(self, mean_pressure: float, initial: Optional[np.ndarray] = None) -> np.ndarray:
+        self.iterations = 0
+        if initial is None or not (initial > 0).any():
+            p = np.full(self.z.shape, float(mean_pressure))
         else:
-            raise RuntimeError(f"numpy BEM solver did not converge in {self.max_iter} iterations "
-                               f"(residual {res:.3g}, violation {viol:.3g}, tol {self.tol:g})")
-        self.iterations = it
-        return p
+            p = initial * (mean_pressure / initial.mean())
+        if self.H is None:
+            return self._pk(self.z, mean_pressure, None, p)
+        H = self.H
+        sat = p >= H
+        n = p.size
+        for _ in range(self.max_outer):
+            load = mean_pressure - H * np.count_nonzero(sat) / n
+            if load <= 0:
+                raise RuntimeError("saturated BEM: the saturated set carries more than the load")
+            held = np.where(sat, H, 0.0)
+            z_eff = self.z - self.K.normal(held)
+            start = np.where(sat, 0.0, np.minimum(p, H))
+            if not (start > 0).any():
+                start = np.where(sat, 0.0, 1.0)
+            start *= load / start.mean()
+            pf = self._pk(z_eff, load, ~sat, start)
+            p = pf + held
+            g = self.K.normal(p) - self.z
+            contact = (pf > 0) & (pf <= H)
+            g -= g[contact].mean() if contact.any() else 0.0
+            add = pf > H
+            release = sat & (g > 10 * self.tol * self._zr)
+            if not add.any() and not release.any():
+                return p
+            sat = (sat | add) & ~release
+        raise RuntimeError(f"saturated BEM: the saturated set did not settle in {self.max_outer} "
+                           "outer iterations")
 
 
 class TamaasSolver:
@@ -610,7 +621,7 @@ def _solver(backend: str, z, size, E_star, nu, hardness, tol):
 
 
 def bem_curves(z, dx: float, dy: Optional[float] = None, *, E_star: float, nu: float,
-               pressures, hardness: Optional[float] = None, backend: str = "tamaas",
+               pressures, hardness: Optional[float] = None, backend: Optional[str] = None,
                boundary: str = "periodic", tol: Optional[float] = None,
                tangential: bool = True, cache: bool = True,
                cache_dir: Optional[os.PathLike] = None) -> BEMCurves:
@@ -623,7 +634,8 @@ def bem_curves(z, dx: float, dy: Optional[float] = None, *, E_star: float, nu: f
             kernel only).
         pressures: (n_p,) mean pressures [MPa], increasing, >= 3 values.
         hardness: None (elastic) or the pressure cap H [MPa] (saturated contact).
-        backend: "tamaas" (default; needs the extra) or "numpy".
+        backend: None (default: "tamaas" for elastic, "numpy" for saturated), "tamaas"
+            (needs the extra rough_contact[bem]) or "numpy".
         boundary: "periodic", "mirror" or "window" (:func:`check_height_map`).
         tol: solver tolerance (default 1e-10 for tamaas, 1e-8 for numpy, both relative).
         tangential: also compute the stick tangential stiffnesses (about doubles the cost).
@@ -643,8 +655,7 @@ def bem_curves(z, dx: float, dy: Optional[float] = None, *, E_star: float, nu: f
     if hardness is not None:
         hardness = check_scalar("hardness", hardness, lo=0.0, unit="MPa")
     pressures = _check_pressures(pressures, hardness)
-    if backend not in _BACKENDS:
-        raise ValueError(f"backend = {backend!r} is invalid; valid: {_BACKENDS}")
+    backend = _default_backend(backend, hardness)
     if backend == "tamaas":
         _import_tamaas()
     tol = (1e-10 if backend == "tamaas" else 1e-8) if tol is None else \
@@ -690,3 +701,343 @@ def bem_curves(z, dx: float, dy: Optional[float] = None, *, E_star: float, nu: f
                  meta=json.dumps({"backend": solver.name, "build_time": elapsed}))
         os.replace(tmp, path)   # atomic: a concurrent reader never sees half a file
     return out
+
+
+# ----------------------------------------------------------------------------------------------
+# the law
+# ----------------------------------------------------------------------------------------------
+def mindlin_ratio(nu: float) -> float:
+    """kT/kN = 2(1 - nu)/(2 - nu) of a circular contact in full stick (Mindlin 1949) [-]."""
+    nu = check_scalar("nu", nu, lo=-1.0, hi=0.5, hi_open=False)
+    return 2.0 * (1.0 - nu) / (2.0 - nu)
+
+
+@dataclass(frozen=True)
+class BEMLaw:
+    """A normal law computed by boundary elements, with its data and its realisation scatter.
+
+    Attributes:
+        normal: the :class:`NormalLaw` (``NormalLaw.from_table`` of the data below): use it
+            wherever a statistical NormalLaw is used.
+        curves: the raw :class:`BEMCurves` (every realisation).
+        separation: (n,) table separations h [mm], increasing.
+        pressure, stiffness, area_fraction: (n,) realisation means at equal separation
+            [MPa, MPa/mm, -].
+        pressure_std, stiffness_std, area_std: (n,) standard deviations over the realisations at
+            equal separation (zeros for one map): the error band of a single realisation; the
+            mean's standard error is std / sqrt(n_realisations).
+        tangential_ratio: (n, 2) kT_x/kN, kT_y/kN in full stick (NaN if not computed) [-].
+        info: backend, grid, timings, interpolation-error estimates, k source, ...
+    """
+
+    normal: NormalLaw
+    curves: BEMCurves
+    separation: np.ndarray
+    pressure: np.ndarray
+    stiffness: np.ndarray
+    area_fraction: np.ndarray
+    pressure_std: np.ndarray
+    stiffness_std: np.ndarray
+    area_std: np.ndarray
+    tangential_ratio: np.ndarray
+    info: dict = field(default_factory=dict)
+
+    def tangential(self):
+        """:class:`TangentialStiffness` with the BEM ratios kT/kN averaged over the table.
+
+        The interface law takes a constant ratio; ``info["tangential_ratio_range"]`` says how
+        much the BEM ratio varies over the load range.
+        """
+        from rough_contact.interface.tangential import TangentialStiffness
+
+        r = np.nanmean(self.tangential_ratio, axis=0)
+        if not np.isfinite(r).all():
+            raise ValueError("the tangential stiffness was not computed (tangential=False)")
+        return TangentialStiffness((float(r[0]), float(r[1])))
+
+
+def _realisation_table(c: BEMCurves, r: int):
+    """(h, p, k, a) of realisation r, ordered by increasing h."""
+    o = np.argsort(c.separation[r])
+    return c.separation[r][o], c.pressure[o], c.stiffness[r][o], c.area_fraction[r][o]
+
+
+def _hermite_eval(h, p, k, a, x):
+    """p, k, a of one realisation at separations x (inside its range), consistent with its k."""
+    from scipy.interpolate import CubicHermiteSpline, PchipInterpolator
+
+    q = CubicHermiteSpline(h, np.log(p), -k / p)
+    pv = np.exp(q(x))
+    kv = -pv * q.derivative()(x)
+    av = np.exp(PchipInterpolator(h, np.log(a))(x))
+    return pv, kv, av
+
+
+def _law_from_data(h, p, k, a, use_k: bool):
+    """NormalLaw from table data; Hermite with k when consistent, else PCHIP. -> (law, source)."""
+    if use_k:
+        try:
+            return NormalLaw.from_table(h, p, a, k=k), "BEM stiffness (Hermite)"
+        except ValueError:
+            pass
+    return NormalLaw.from_table(h, p, a), "derivative of the PCHIP interpolant of ln p"
+
+
+def _interpolation_error(h, p, k, a, use_k):
+    """Leave-every-other-knot-out estimate of the table's interpolation error (max relative)."""
+    if h.size < 5:
+        return {"p": float("nan"), "k": float("nan"), "a": float("nan")}
+    keep = np.zeros(h.size, bool)
+    keep[::2] = True
+    keep[-1] = True
+    law, _ = _law_from_data(h[keep], p[keep], k[keep], a[keep], use_k)
+    x = ~keep
+    pv, kv, av = law.evaluate(h[x])
+    return {"p": float(np.max(np.abs(pv / p[x] - 1))), "k": float(np.max(np.abs(kv / k[x] - 1))),
+            "a": float(np.max(np.abs(av / a[x] - 1)))}
+
+
+def law_from_curves(curves: BEMCurves) -> BEMLaw:
+    """Tabulate :class:`BEMCurves` (one or more realisations) as a :class:`BEMLaw`.
+
+    One realisation: the knots are its solved points. Several: every realisation's ln p(h) is
+    interpolated (cubic Hermite with its own stiffness) onto common separations inside the range
+    all realisations cover, and p, k, A/A0 are averaged *at equal separation* (the mean pressure
+    of many interface patches at the same separation); the standard deviations are the band.
+    The table uses the BEM stiffness as Hermite slope data when the elastic law is tabulated
+    and the data are consistent (monotone), else the PCHIP derivative (always for a hardness:
+    there the frozen-set stiffness misses the first-order growth of the saturated set).
+    """
+    nr = curves.n_realisations
+    use_k = curves.hardness is None
+    tabs = [_realisation_table(curves, r) for r in range(nr)]
+    if nr == 1:
+        h, p, k, a = tabs[0]
+        ps = ks = as_ = np.zeros_like(h)
+        kt = curves.tangential_stiffness[0][np.argsort(curves.separation[0])]
+        ratio = kt / k[:, None]
+    else:
+        lo = max(t[0][0] for t in tabs)
+        hi = min(t[0][-1] for t in tabs)
+        if not hi > lo:
+            raise ValueError("the realisations share no separation range: widen the pressures")
+        hm = np.sort(np.mean([t[0] for t in tabs], axis=0))
+        h = np.unique(np.clip(hm, lo, hi))
+        vals = np.array([_hermite_eval(*t, h) for t in tabs])        # (nr, 3, n)
+        p, k, a = vals.mean(axis=0)
+        ps, ks, as_ = vals.std(axis=0, ddof=1)
+        ratio = np.full((h.size, 2), np.nan)
+        if np.isfinite(curves.tangential_stiffness).all():
+            # the ratio kT/kN varies slowly: average each realisation's ratio at equal h
+            rr = []
+            for r, t in enumerate(tabs):
+                o = np.argsort(curves.separation[r])
+                kt = curves.tangential_stiffness[r][o] / t[2][:, None]
+                rr.append([np.interp(h, t[0], kt[:, j]) for j in range(2)])
+            ratio = np.mean(rr, axis=0).T
+    law, source = _law_from_data(h, p, k, a, use_k)
+    info = {
+        "source": "bem", "backend": curves.backend, "grid": list(curves.grid),
+        "size_mm": list(curves.size), "realisations": nr, "hardness": curves.hardness,
+        "E_star": curves.E_star, "nu": curves.nu, "k_source": source,
+        "build_time_s": float(np.sum(curves.build_time)),
+        "cached": int(np.count_nonzero(curves.cached)),
+        "pressure_range": [float(p.min()), float(p.max())],
+        "area_range": [float(a.min()), float(a.max())],
+        "interpolation_error": _interpolation_error(h, p, k, a, use_k and "Hermite" in source),
+    }
+    pk, kk, ak = law.evaluate(h)
+    info["table_k_error"] = float(np.max(np.abs(kk / k - 1)))
+    if np.isfinite(ratio).all():
+        info["tangential_ratio_range"] = [[float(ratio[:, j].min()), float(ratio[:, j].max())]
+                                          for j in range(2)]
+    law.info.update(info)
+    return BEMLaw(normal=law, curves=curves, separation=h, pressure=p, stiffness=k,
+                  area_fraction=a, pressure_std=ps, stiffness_std=ks, area_std=as_,
+                  tangential_ratio=ratio, info=info)
+
+
+def default_pressures(E_star: float, rms_slope: float, hardness: Optional[float] = None,
+                      area_range: Tuple[float, float] = (0.005, 0.3),
+                      n: int = 16) -> np.ndarray:
+    """Mean pressures [MPa] expected to span ``area_range`` of A/A0 (n, log-spaced).
+
+    Uses the proportionality A/A0 ~ 2 p / (E* rms_slope) of exact elastic rough contact at light
+    load (Persson; Hyun et al. find a factor 1.6-2.5) only to *place* the pressures; the areas
+    actually reached are in the result. With a hardness, A/A0 >= p/H caps the largest pressure.
+    """
+    E_star = check_scalar("E_star", E_star, lo=0.0, unit="MPa")
+    rms_slope = check_scalar("rms_slope", rms_slope, lo=0.0)
+    a0 = check_scalar("area_range[0]", area_range[0], lo=0.0, hi=1.0)
+    a1 = check_scalar("area_range[1]", area_range[1], lo=a0, hi=1.0)
+    n = int(check_scalar("n", n, lo=3.0, lo_open=False, hi=1e4))
+    lo, hi = 0.5 * a0 * E_star * rms_slope, 0.5 * a1 * E_star * rms_slope
+    if hardness is not None:
+        H = check_scalar("hardness", hardness, lo=0.0, unit="MPa")
+        hi = min(hi, 0.9 * a1 * H)
+        lo = min(lo, hi / 20.0)
+    return np.geomspace(lo, hi, n)
+
+
+def _default_backend(backend: Optional[str], hardness) -> str:
+    if backend is None:
+        return "tamaas" if hardness is None else "numpy"
+    if backend not in _BACKENDS:
+        raise ValueError(f"backend = {backend!r} is invalid; valid: {_BACKENDS} or None")
+    if backend == "tamaas" and hardness is not None:
+        raise ValueError(
+            "backend = 'tamaas' with a hardness is not supported: Tamaas' KatoSaturated stalled "
+            "above its tolerance and needs dimensionless inputs in our checks (docs/bem.md); "
+            "the saturated variant uses backend='numpy' (the default when hardness is given)")
+    return backend
+
+
+def bem_normal_law(z, dx: float, dy: Optional[float] = None, *, E_star: float, nu: float = 0.3,
+                   pressures=None, area_range: Tuple[float, float] = (0.005, 0.3),
+                   n_pressures: int = 16, hardness: Optional[float] = None,
+                   backend: Optional[str] = None, boundary: str = "periodic",
+                   tol: Optional[float] = None, tangential: bool = True, cache: bool = True,
+                   cache_dir: Optional[os.PathLike] = None) -> BEMLaw:
+    """The BEM normal law of one height map (measured or synthetic).
+
+    Args:
+        z: (nx, ny) heights [mm], axis 0 = x (grain direction).
+        dx, dy: sampling steps [mm] (dy defaults to dx).
+        E_star: effective modulus E* [MPa]; nu: Poisson ratio [-] (tangential stiffness).
+        pressures: mean pressures to solve [MPa] (increasing, >= 3); default
+            :func:`default_pressures` over ``area_range`` with ``n_pressures`` values.
+        hardness: None (elastic) or the pressure cap H [MPa] (saturated, elasto-plastic).
+        backend: None (default: "tamaas" for elastic, "numpy" for saturated), "tamaas", "numpy".
+        boundary, tol, tangential, cache, cache_dir: see :func:`bem_curves`.
+
+    Returns:
+        :class:`BEMLaw`; ``.normal`` is the NormalLaw for the FE layer. Its table spans the
+        solved pressures: below the smallest separation the stiff continuation, beyond the
+        largest the cubic taper of :class:`NormalLaw` apply (the BEM resolves no lighter load).
+    """
+    backend = _default_backend(backend, hardness)
+    if pressures is None:
+        zc, diag = check_height_map(z, dx, dy, boundary=boundary)
+        pressures = default_pressures(E_star, diag.rms_slope, hardness, area_range, n_pressures)
+    c = bem_curves(z, dx, dy, E_star=E_star, nu=nu, pressures=pressures, hardness=hardness,
+                   backend=backend, boundary=boundary, tol=tol, tangential=tangential,
+                   cache=cache, cache_dir=cache_dir)
+    return law_from_curves(c)
+
+
+def bem_law_from_moments(moments: SpectralMoments, *, E_star: float, nu: float = 0.3,
+                         n_realisations: int = 4, pixels_per_wavelength: float = 4.0,
+                         periods: int = 1, shape=None, seed: int = 0, pressures=None,
+                         area_range: Tuple[float, float] = (0.005, 0.3), n_pressures: int = 16,
+                         hardness: Optional[float] = None, backend: Optional[str] = None,
+                         tol: Optional[float] = None, tangential: bool = True,
+                         cache: bool = True, cache_dir: Optional[os.PathLike] = None) -> BEMLaw:
+    """The BEM law of a surface known only by its spectral moments, with realisation scatter.
+
+    Gaussian realisations of the spectrum fitted by :func:`rough_contact.spectrum.fit_spectrum`
+    (the assumed shape is documented there: stretched isotropic self-affine with roll-off) are
+    solved at the same pressures and averaged at equal separation (:func:`law_from_curves`).
+
+    Args:
+        moments: :class:`SpectralMoments` (x = grain direction).
+        E_star, nu, hardness, backend, tol, tangential, cache, cache_dir: as in
+            :func:`bem_normal_law`.
+        n_realisations: number of realisations (seeds seed, seed + 1, ...), >= 1.
+        pixels_per_wavelength: pixels per shortest wavelength of the spectrum (grid study in
+            docs/bem.md).
+        periods: longest wavelengths per side of every realisation.
+        shape: :class:`rough_contact.spectrum.SpectrumShape` (default H = 0.8, plateau 2).
+        pressures: mean pressures [MPa]; default from the moments' rms slope over area_range.
+
+    Returns:
+        :class:`BEMLaw` whose ``*_std`` give the scatter between realisations.
+    """
+    from rough_contact.spectrum import SpectrumShape, fit_spectrum
+
+    nr = int(check_scalar("n_realisations", n_realisations, lo=1.0, lo_open=False, hi=1e4))
+    backend = _default_backend(backend, hardness)
+    spec = fit_spectrum(moments, SpectrumShape() if shape is None else shape)
+    (nx, ny), (Lx, Ly) = spec.grid(pixels_per_wavelength, periods)
+    if pressures is None:
+        pressures = default_pressures(E_star, math.sqrt(moments.m20 + moments.m02), hardness,
+                                      area_range, n_pressures)
+    curves = []
+    for r in range(nr):
+        zr = spec.realisation((nx, ny), (Lx, Ly), seed + r)
+        curves.append(bem_curves(zr, Lx / nx, Ly / ny, E_star=E_star, nu=nu,
+                                 pressures=pressures, hardness=hardness, backend=backend,
+                                 tol=tol, tangential=tangential, cache=cache,
+                                 cache_dir=cache_dir))
+    out = law_from_curves(BEMCurves.stack(curves))
+    out.info.update({"spectrum": {"C_mm4": spec.C, "q_l": spec.q_l, "q_r": spec.q_r,
+                                  "q_s": spec.q_s, "hurst": spec.hurst, "gx": spec.gx,
+                                  "gy": spec.gy},
+                     "pixels_per_wavelength": float(pixels_per_wavelength),
+                     "periods": int(periods), "seeds": [seed + r for r in range(nr)]})
+    out.normal.info.update(out.info)
+    return out
+
+
+# ----------------------------------------------------------------------------------------------
+# comparison of laws
+# ----------------------------------------------------------------------------------------------
+def law_ratios(law: NormalLaw, reference: NormalLaw, pressures) -> Dict[str, np.ndarray]:
+    """Ratios law/reference over a load range, at equal separation and at equal load.
+
+    Args:
+        law, reference: the two laws (e.g. statistical and BEM).
+        pressures: (n,) mean pressures [MPa] > 0 (the load range).
+
+    Returns:
+        dict of (n,) arrays: ``h`` (reference separation at each load [mm]), ``p_at_h``,
+        ``k_at_h``, ``a_at_h`` (ratios at the reference's separation), ``k_at_p``, ``a_at_p``
+        (ratios at equal load), ``dh_at_p`` (law's minus reference's separation at equal
+        load [mm]).
+    """
+    pr = np.asarray(pressures, float)
+    if not np.all(np.isfinite(pr) & (pr > 0)):
+        raise ValueError("pressures must be finite and > 0 MPa")
+    h = reference.separation_for_pressure(pr)
+    pr_r, kr_r, ar_r = reference.evaluate(h)
+    pl, kl, al = law.evaluate(h)
+    hl = law.separation_for_pressure(pr)
+    _, kl2, al2 = law.evaluate(hl)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return {"h": h, "p_at_h": pl / pr_r, "k_at_h": kl / kr_r, "a_at_h": al / ar_r,
+                "k_at_p": kl2 / kr_r, "a_at_p": al2 / ar_r, "dh_at_p": hl - h}
+
+
+def agreement_range(law: NormalLaw, reference: NormalLaw, pressures, tol: float = 0.1,
+                    quantities: Sequence[str] = ("p_at_h", "k_at_p", "a_at_p")):
+    """Load range over which ``law`` agrees with ``reference`` within ``tol``.
+
+    Args:
+        law, reference, pressures: as in :func:`law_ratios`.
+        tol: largest accepted relative deviation of every ratio in ``quantities`` [-].
+        quantities: keys of :func:`law_ratios` (ratios) that must agree.
+
+    Returns:
+        (p_lo, p_hi) [MPa], the widest contiguous run of the given pressures where all ratios
+        are within 1 +- tol, or None if there is none.
+    """
+    tol = check_scalar("tol", tol, lo=0.0)
+    pr = np.asarray(pressures, float)
+    r = law_ratios(law, reference, pr)
+    ok = np.ones(pr.size, bool)
+    for q in quantities:
+        if q not in r or q in ("h", "dh_at_p"):
+            raise ValueError(f"quantity {q!r} is invalid; valid: p_at_h, k_at_h, a_at_h, "
+                             "k_at_p, a_at_p")
+        ok &= np.abs(r[q] - 1.0) <= tol
+    if not ok.any():
+        return None
+    # widest contiguous run of True
+    best, start, run = (0, 0), None, 0
+    for i, v in enumerate(np.append(ok, False)):   # scalar loop over a short load grid
+        if v and start is None:
+            start = i
+        if not v and start is not None:
+            if i - start > best[1] - best[0]:
+                best = (start, i)
+            start = None
+    return float(pr[best[0]]), float(pr[best[1] - 1])
