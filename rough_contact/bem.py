@@ -160,7 +160,10 @@ def spacing_from_coordinates(x, y, rtol: float = 1e-3) -> Tuple[float, float]:
 
 
 def _correlation_lengths(z: np.ndarray) -> Tuple[float, float]:
-    """Correlation lengths along both axes in pixels: first lag where the ACF falls below 1/e."""
+    """Correlation lengths along both axes in pixels: first lag where the ACF falls below 1/e.
+
+    inf where it never does within half the map (a surface constant along that axis).
+    """
     Z = _rfft2(z)
     acf = _irfft2(np.abs(Z) ** 2, s=z.shape)
     acf /= acf[0, 0]
@@ -168,7 +171,7 @@ def _correlation_lengths(z: np.ndarray) -> Tuple[float, float]:
     for line in (acf[: z.shape[0] // 2 + 1, 0], acf[0, : z.shape[1] // 2 + 1]):
         below = np.flatnonzero(line < math.exp(-1.0))
         if below.size == 0:
-            out.append(float(line.size))       # longer than half the map
+            out.append(math.inf)               # no decorrelation along this axis (e.g. a wave)
             continue
         j = int(below[0])
         # linear interpolation between lags j-1 and j

@@ -48,7 +48,7 @@ from scipy.optimize import brentq
 from rough_contact.surface import SpectralMoments
 from rough_contact.validation import check_scalar
 
-__all__ = ["SpectrumShape", "StretchedSpectrum", "fit_spectrum"]
+__all__ = ["SpectrumShape", "StretchedSpectrum", "fit_spectrum", "example_surfaces"]
 
 # relative mismatch of m04/m40 against (m02/m20)^2 above which fit_spectrum warns
 _MOMENT_MISMATCH_WARN = 0.05
@@ -278,3 +278,34 @@ def fit_spectrum(moments: SpectralMoments,
     C = m00 / (2 * math.pi * qr ** 2 * i1)
     return StretchedSpectrum(C=C, q_l=qr / shape.plateau, q_r=qr, q_s=zeta * qr,
                              hurst=shape.hurst, gx=gx, gy=gy)
+
+
+def example_surfaces() -> dict:
+    """The surfaces of the studies in docs/bem.md, as (SpectralMoments, SpectrumShape) pairs.
+
+    All have m00 = 0.625 um^2 and the paper's geometric-mean slope variance
+    sqrt(m20 m02) = 2.53e-4 (um convention):
+
+    * ``"isotropic"``: isotropic Gaussian, bandwidth alpha = 10 (q_s/q_r = 10.4 with H = 0.8);
+    * ``"anisotropic"``: the same, stretched to m02/m20 = 10 (m04/m40 = 100: strongly
+      anisotropic, x = grain);
+    * ``"self-affine"``: isotropic, broadband self-affine H = 0.8 over q_s/q_r = 32
+      (alpha = 42.7);
+    * ``"paper"``: the paper's surface of Figs 18-19 (m04/m40 = 100, alpha = 101.6:
+      q_s/q_r = 59, the most expensive).
+    """
+    import warnings as _w
+
+    m00, m2 = 0.625, math.sqrt(8e-5 * 8e-4)
+    base = SpectrumShape(hurst=0.8, plateau=2.0)
+    with _w.catch_warnings():
+        # the isotropic surfaces are outside the strongly anisotropic statistical model's range
+        _w.simplefilter("ignore", UserWarning)
+        iso = SpectralMoments(m00, m2, m2, 10 * m2 ** 2 / m00, 10 * m2 ** 2 / m00)
+        m20, m02 = m2 / math.sqrt(10), m2 * math.sqrt(10)
+        aniso = SpectralMoments(m00, m20, m02, 10 * m20 ** 2 / m00, 10 * m02 ** 2 / m00)
+        a_sa = _alpha(base, 32.0)
+        sa = SpectralMoments(m00, m2, m2, a_sa * m2 ** 2 / m00, a_sa * m2 ** 2 / m00)
+        paper = SpectralMoments(m00=0.625, m20=8e-5, m02=8e-4, m40=1.04e-6, m04=1.04e-4)
+    return {"isotropic": (iso, base), "anisotropic": (aniso, base), "self-affine": (sa, base),
+            "paper": (paper, base)}
