@@ -7,9 +7,10 @@ elasto-plastic law against the elastic / saturated BEM law, realisations average
 separation) and prints and saves the ratios statistical/BEM of p, A/A0 and k at equal separation
 (and A/A0, k at equal load) over the load range, with the load ranges of agreement.
 
-    bash run.sh python benchmarks/bench_bem_vs_statistical.py                   # ~5 min
-    bash run.sh python benchmarks/bench_bem_vs_statistical.py --realisations 32 --ppw 16 \\
-        --surfaces isotropic anisotropic self-affine paper --plastic            # ~1-2 h
+    bash run.sh python benchmarks/bench_bem_vs_statistical.py --csv /tmp/q.csv --figdir /tmp
+        # quick: 8 realisations of one roll-off period (~7 min; large sampling error)
+    bash run.sh python benchmarks/bench_bem_vs_statistical.py --periods 2 --realisations 12
+        # the docs/bem.md results (~45 min on one core)
 
 Writes docs/bem_vs_statistical.csv, docs/figures/bem_vs_statistical.png and one
 docs/figures/bem_compare_<surface>.png per surface.
@@ -29,6 +30,7 @@ import compare_laws  # noqa: E402
 from rough_contact.spectrum import example_surfaces  # noqa: E402
 
 PPW = {"isotropic": 8.0, "anisotropic": 8.0, "self-affine": 4.0, "paper": 4.0}
+SE = {"p_at_h": "se_p", "a_at_h": "se_a", "k_at_h": "se_k", "a_at_p": "se_a", "k_at_p": "se_k"}
 
 
 def figure(results, path):
@@ -49,8 +51,13 @@ def figure(results, path):
                 rows = [r for r in res["rows"] if r["law"] == name]
                 if not rows:
                     continue
-                a.semilogx([r["p [MPa]"] for r in rows], [r[key] for r in rows], st, ms=3,
-                           label=name)
+                x = np.array([r["p [MPa]"] for r in rows])
+                y = np.array([r[key] for r in rows])
+                se = np.array([r[SE[key]] for r in rows])
+                a.semilogx(x, y, st, ms=3, label=name)
+                # sampling uncertainty of the BEM mean (+- 1 standard error)
+                a.fill_between(x, y / (1 + se), y / np.maximum(1 - se, 0.05), color=st[:2],
+                               alpha=0.12, lw=0)
             a.axhline(1.0, color="k", lw=0.8)
             a.axhspan(0.9, 1.1, color="0.85", zorder=0)
             a.grid(True, which="both", alpha=0.3)
@@ -70,13 +77,18 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0], allow_abbrev=False)
     ap.add_argument("--surfaces", nargs="+", default=["isotropic", "anisotropic", "self-affine"],
                     choices=list(example_surfaces()))
-    ap.add_argument("--realisations", type=int, default=12)
+    ap.add_argument("--realisations", type=int, default=8)
     ap.add_argument("--ppw", type=float, default=None, help="default: 8 (4 for broadband)")
     ap.add_argument("--pressures", type=int, default=10)
-    ap.add_argument("--plastic", action="store_true",
-                    help="also the elasto-plastic law vs the saturated BEM law")
+    ap.add_argument("--plastic", nargs="*", default=["anisotropic"],
+                    help="surfaces on which the elasto-plastic law is also compared with the "
+                    "saturated BEM law (default: anisotropic; none: --plastic)")
     ap.add_argument("--psi", type=float, default=2.0,
                     help="plasticity index for --plastic (the paper's 0.35 is elastic here)")
+    ap.add_argument("--tangential", nargs="*", default=["anisotropic"],
+                    help="surfaces on which the stick tangential stiffness is also computed")
+    ap.add_argument("--periods", type=int, default=1,
+                    help="roll-off wavelengths per side of each realisation")
     ap.add_argument("--tol", type=float, default=0.1)
     ap.add_argument("--backend", default=None, choices=["tamaas", "numpy"])
     ap.add_argument("--csv", default="docs/bem_vs_statistical.csv")
@@ -88,9 +100,10 @@ def main(argv=None):
         print(f"\n=== {surf} ===", flush=True)
         res = compare_laws.compare(
             dict(kind="moments", moments=m, shape=shape), psi=args.psi, tol=args.tol,
-            realisations=args.realisations, ppw=args.ppw or PPW[surf],
+            realisations=args.realisations, ppw=args.ppw or PPW[surf], periods=args.periods,
+            tangential=surf in args.tangential,
             n_pressures=args.pressures, area_range=(0.002, 0.4), backend=args.backend,
-            plastic=args.plastic, out=None, verbose=False, label=surf)
+            plastic=surf in args.plastic, out=None, verbose=False, label=surf)
         rows = []
         for r in res["ratios"]:
             rows.append({"surface": surf, "law": r["law"], "p [MPa]": r["p [MPa]"],
@@ -98,7 +111,8 @@ def main(argv=None):
                          "p_at_h": r["p ratio at equal h"], "a_at_h": r["A ratio at equal h"],
                          "k_at_h": r["k ratio at equal h"], "a_at_p": r["A ratio at equal p"],
                          "k_at_p": r["k ratio at equal p"],
-                         "dh_sigma_at_p": r["dh/sigma at equal p"]})
+                         "dh_sigma_at_p": r["dh/sigma at equal p"], "se_p": r["se p"],
+                         "se_a": r["se A"], "se_k": r["se k"]})
         b = res["bem"]["BEM elastic"]
         results[surf] = dict(rows=rows, agree=res["agree"], info=b.info,
                              scatter=(float(np.max(b.pressure_std / b.pressure)),
@@ -116,10 +130,12 @@ def main(argv=None):
                               f"{surf}: statistical vs BEM (band: +-1 std over "
                               f"{b.info['realisations']} realisations, {b.info['grid'][0]}^2 px)")
     # ---- print
-    print(f"\nStatistical / BEM ratios (mean of the realisations at equal separation); "
-          f"'valid' = statistical law inside its validity range")
+    print("\nStatistical / BEM ratios (BEM: mean of the realisations at equal separation); "
+          "'valid': statistical law inside its validity range; s.e.: relative standard error "
+          "of the BEM mean (realisation std / sqrt(n)), the sampling uncertainty of the ratios")
     hdr = (f"{'surface':12s} {'law':22s} {'p [MPa]':>8s} {'h/sig':>6s} {'valid':>5s} "
-           f"{'p(h)':>6s} {'A(h)':>6s} {'k(h)':>6s} {'A(p)':>6s} {'k(p)':>6s} {'dh/sig':>7s}")
+           f"{'p(h)':>6s} {'A(h)':>6s} {'k(h)':>6s} {'A(p)':>6s} {'k(p)':>6s} {'dh/sig':>7s}"
+           f"  {'s.e. p/A/k':>14s}")
     print(hdr)
     print("-" * len(hdr))
     all_rows = []
@@ -129,7 +145,7 @@ def main(argv=None):
             print(f"{surf:12s} {r['law'][:22]:22s} {r['p [MPa]']:8.3g} {r['h/sigma']:6.2f} "
                   f"{r['stat valid']:>5s} {r['p_at_h']:6.3f} {r['a_at_h']:6.3f} "
                   f"{r['k_at_h']:6.3f} {r['a_at_p']:6.3f} {r['k_at_p']:6.3f} "
-                  f"{r['dh_sigma_at_p']:7.3f}")
+                  f"{r['dh_sigma_at_p']:7.3f}  {r['se_p']:4.2f}/{r['se_a']:4.2f}/{r['se_k']:4.2f}")
     print(f"\nLoad ranges [MPa] of agreement within {args.tol:.0%}:")
     for surf, res in results.items():
         i = res["info"]

@@ -115,15 +115,26 @@ def table_vs_load(laws: dict, sigma: float, pressures):
     return rows
 
 
-def ratio_rows(stat: dict, reference: NormalLaw, pressures, sigma):
-    """Ratios statistical/BEM over the load range (rough_contact.bem.law_ratios)."""
+def ratio_rows(stat: dict, reference: "bem.BEMLaw", pressures, sigma):
+    """Ratios statistical/BEM over the load range (rough_contact.bem.law_ratios).
+
+    ``se p/A/k``: relative standard errors of the BEM mean (realisation std / sqrt(n)) at the
+    BEM separation of each load - the uncertainty of every ratio from the finite sample.
+    """
     rows = []
+    n = reference.curves.n_realisations
     for name, law in stat.items():
-        r = bem.law_ratios(law, reference, pressures)
+        r = bem.law_ratios(law, reference.normal, pressures)
         below = law.below_validity(law.separation_for_pressure(pressures))
+        se = [np.interp(r["h"], reference.separation, std / val) / math.sqrt(n)
+              for std, val in ((reference.pressure_std, reference.pressure),
+                               (reference.area_std, reference.area_fraction),
+                               (reference.stiffness_std, reference.stiffness))]
         for i, pm in enumerate(pressures):
             rows.append({"law": name, "p [MPa]": float(pm), "h/sigma (BEM)": r["h"][i] / sigma,
                          "stat valid": "no" if below[i] else "yes",
+                         "se p": float(se[0][i]), "se A": float(se[1][i]),
+                         "se k": float(se[2][i]),
                          "p ratio at equal h": r["p_at_h"][i], "A ratio at equal h": r["a_at_h"][i],
                          "k ratio at equal h": r["k_at_h"][i], "A ratio at equal p": r["a_at_p"][i],
                          "k ratio at equal p": r["k_at_p"][i],
@@ -200,7 +211,7 @@ def plot(laws: dict, bands: dict, sigma: float, pressures, path, title):
 # ## The run
 def compare(source: dict, *, E_star=E_STAR, nu=NU, psi=0.35, tol=0.1, realisations=8, ppw=8.0,
             periods=1, n_pressures=12, area_range=(0.005, 0.3), backend=None, seed=0,
-            plastic=True, out=None, verbose=True, label=""):
+            plastic=True, tangential=True, out=None, verbose=True, label=""):
     """Build every law, print the tables, write CSV/PNG into ``out``; return a dict of results."""
     t0 = time.perf_counter()
     moments = source["moments"]
@@ -213,7 +224,7 @@ def compare(source: dict, *, E_star=E_STAR, nu=NU, psi=0.35, tol=0.1, realisatio
     t_bem = time.perf_counter()
     bl = bem_laws(source, E_star, nu, cap if plastic else None, realisations=realisations,
                   ppw=ppw, periods=periods, n_pressures=n_pressures, area_range=area_range,
-                  backend=backend, seed=seed)
+                  backend=backend, seed=seed, tangential=tangential)
     t_bem = time.perf_counter() - t_bem
     ref = bl["BEM elastic"]
     laws = dict(stat)
@@ -223,17 +234,23 @@ def compare(source: dict, *, E_star=E_STAR, nu=NU, psi=0.35, tol=0.1, realisatio
     s_grid = np.linspace(ref.separation.min(), ref.separation.max(), 7) / sigma
     by_h = table_vs_separation(laws, sigma, s_grid)
     by_p = table_vs_load(laws, sigma, pressures)
-    ratios = ratio_rows({k: stat[k] for k in (STAT[0], STAT[2]) if k in stat}, ref.normal,
+    ratios = ratio_rows({k: stat[k] for k in (STAT[0], STAT[2]) if k in stat}, ref,
                         pressures, sigma)
+    p_sat = pressures
     if plastic:
-        ratios += ratio_rows({STAT[1]: stat[STAT[1]]}, bl["BEM saturated"].normal, pressures,
-                             sigma)
+        sat = bl["BEM saturated"]
+        # the saturated table covers a different load range: compare inside both tables
+        lo = max(sat.pressure.min(), ref.pressure.min())
+        hi = min(sat.pressure.max(), ref.pressure.max())
+        p_sat = np.geomspace(lo, hi, 9)
+        ratios += ratio_rows({STAT[1]: stat[STAT[1]]}, sat, p_sat, sigma)
     agree = {}
     for name in stat:
-        reference = bl["BEM saturated"].normal if name == STAT[1] else ref.normal
-        agree[name] = {q: bem.agreement_range(stat[name], reference, pressures, tol, (q,))
+        reference, pr = (bl["BEM saturated"].normal, p_sat) if name == STAT[1] else \
+            (ref.normal, pressures)
+        agree[name] = {q: bem.agreement_range(stat[name], reference, pr, tol, (q,))
                        for q in AGREE}
-        agree[name]["all"] = bem.agreement_range(stat[name], reference, pressures, tol, AGREE)
+        agree[name]["all"] = bem.agreement_range(stat[name], reference, pr, tol, AGREE)
     info = ref.info
     if verbose:
         print(f"Surface {label}: m00 = {moments.m00 * 1e6:.4g} um^2, m20 = {moments.m20:.4g}, "
@@ -345,9 +362,19 @@ def main(argv=None):
     ap.add_argument("--area-range", nargs=2, type=float, default=(0.005, 0.3))
     ap.add_argument("--backend", default=None, choices=["tamaas", "numpy"])
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--resolution-check", action="store_true",
+                    help="height map: also solve the map sub-sampled by 2 and report the change")
     ap.add_argument("--out", default="results/compare_laws")
     args = ap.parse_args(argv)
     source, label = source_from_args(args)
+    if args.resolution_check:
+        if source["kind"] != "map":
+            raise SystemExit("--resolution-check needs --height-map")
+        r = bem.resolution_check(source["z"], source["dx"], source["dy"], E_star=args.E_star,
+                                 nu=args.nu, boundary=source["boundary"], backend=args.backend)
+        print(f"resolution check (map vs map sub-sampled by 2, elastic BEM): max change of p(h) "
+              f"{r['p']:.2%}, k(h) {r['k']:.2%}, A/A0(h) {r['a']:.2%} (the full map's own "
+              "discretisation error is roughly 2-4x smaller, docs/bem.md)")
     return compare(source, E_star=args.E_star, nu=args.nu, psi=args.psi, tol=args.tol,
                    realisations=args.realisations, ppw=args.ppw, periods=args.periods,
                    n_pressures=args.pressures, area_range=tuple(args.area_range),

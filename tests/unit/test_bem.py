@@ -455,3 +455,15 @@ def test_pure_layer():
             "set(sys.modules)\n"
             "assert not bad, bad\n")
     subprocess.run([sys.executable, "-c", code], check=True)
+
+
+def test_resolution_check(rough, tmp_path):
+    """Coarsening a well-resolved map by 2 changes p(h) little and A/A0 the most."""
+    z, dx, dy = rough
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", HeightMapWarning)
+        r = bem.resolution_check(z, dx, dy, E_star=E_STAR, nu=NU,
+                                 pressures=rough_pressures(z, dx, 5), backend="numpy",
+                                 cache_dir=tmp_path)
+    assert r["factor"] == 2 and r["coarse"].curves.grid == (z.shape[0] // 2, z.shape[1] // 2)
+    assert 0 < r["p"] < r["a"] and r["p"] < 0.05
