@@ -36,13 +36,17 @@ interpenetrate the flat, which models material flattened away; volume is not con
 saturated case d = mean over the elastic (0 < p < H) contact points of z - u, and k is the
 derivative with the saturated and open sets frozen.
 
-Backends (``backend=``): ``"tamaas"`` (default) uses Tamaas (``pip install rough_contact[bem]``;
-Polonsky-Keer-Rey for elastic, Kato's saturated solver for a hardness) for the contact solves;
-``"numpy"`` is this module's own Polonsky-Keer constrained conjugate gradient (with a pressure cap
-for the saturated case), the reference implementation and the fallback where Tamaas is absent.
-Both use the same half-space operator (Tamaas' basic_2d displacement equals ``2 p(q)/(E* |q|)``
-to round-off, checked in the tests); the post-processing (d, A/A0, k, kT) is this module's for
-both. The backend that ran is recorded in every result (``BEMCurves.backend``, ``info``).
+Backends (``backend=``): ``"tamaas"`` uses Tamaas' Polonsky-Keer-Rey solver (the optional extra
+``rough_contact[bem]``); ``"numpy"`` is this module's own Polonsky-Keer constrained conjugate
+gradient, with an active-set loop for the pressure cap, the reference implementation and the
+fallback where Tamaas is absent (pass it explicitly: a missing Tamaas raises
+:class:`BackendUnavailableError`, never a silent switch). Default (``None``): "tamaas" for elastic
+contact, "numpy" for the saturated variant - Tamaas' KatoSaturated stalled above its tolerance
+in our checks (and its tolerance is absolute: mm-sized inputs stop it at once), so it is not used.
+Both use the same half-space operator (Tamaas' basic_2d displacement equals
+``2 p(q)/(E* |q|)`` to round-off, checked in the tests) and agree to 1e-7 and better; the
+post-processing (d, A/A0, k, kT) is this module's for both. The backend that ran is recorded in
+every result (``BEMCurves.backend``, ``info["backend"]``).
 
 Pure module: numpy and scipy (tamaas imported lazily); no dolfinx, petsc4py, mpi4py.
 """
@@ -1051,16 +1055,11 @@ def agreement_range(law: NormalLaw, reference: NormalLaw, pressures, tol: float 
         ok &= np.abs(r[q] - 1.0) <= tol
     if not ok.any():
         return None
-    # widest contiguous run of True
-    best, start, run = (0, 0), None, 0
-    for i, v in enumerate(np.append(ok, False)):   # scalar loop over a short load grid
-        if v and start is None:
-            start = i
-        if not v and start is not None:
-            if i - start > best[1] - best[0]:
-                best = (start, i)
-            start = None
-    return float(pr[best[0]]), float(pr[best[1] - 1])
+    # widest contiguous run of True: starts and ends from the edges of the padded mask
+    edges = np.diff(np.concatenate([[0], ok.astype(np.int8), [0]]))
+    starts, ends = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
+    j = int(np.argmax(ends - starts))
+    return float(pr[starts[j]]), float(pr[ends[j] - 1])
 
 
 def resolution_check(z, dx: float, dy: Optional[float] = None, *, E_star: float,

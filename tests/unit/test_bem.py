@@ -401,6 +401,16 @@ def test_law_ratios_and_agreement(rough_law):
     np.testing.assert_allclose(r["p_at_h"], 1.2, rtol=1e-9)
     assert bem.agreement_range(scaled, law, pr, 0.1) is None
     assert bem.agreement_range(scaled, law, pr, 0.25) == pytest.approx((pr[0], pr[-1]))
+    # a law drifting away with separation agrees only at the heavy loads (small h)
+    h = rough_law.separation
+    f = 1.0 + 0.5 * (h - h[0]) / (h[-1] - h[0])
+    drift = NormalLaw.from_table(h, f * rough_law.pressure, rough_law.area_fraction)
+    r = bem.law_ratios(drift, law, pr)
+    lo, hi = bem.agreement_range(drift, law, pr, 0.1, ("p_at_h",))
+    inside = (pr >= lo) & (pr <= hi)
+    assert hi == pr[-1] and lo > pr[0]
+    assert np.all(np.abs(r["p_at_h"][inside] - 1) <= 0.1)
+    assert np.all(np.abs(r["p_at_h"][~inside] - 1) > 0.1)
 
 
 # ----------------------------------------------------------------------------------------------
