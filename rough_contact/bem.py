@@ -1045,7 +1045,7 @@ def agreement_range(law: NormalLaw, reference: NormalLaw, pressures, tol: float 
         are within 1 +- tol, or None if there is none.
     """
     tol = check_scalar("tol", tol, lo=0.0)
-    pr = np.asarray(pressures, float)
+    pr = np.sort(np.asarray(pressures, float).ravel())
     r = law_ratios(law, reference, pr)
     ok = np.ones(pr.size, bool)
     for q in quantities:
