@@ -390,7 +390,7 @@ def test_backend_absent(monkeypatch, rough):
 # ----------------------------------------------------------------------------------------------
 def test_law_ratios_and_agreement(rough_law):
     law = rough_law.normal
-    pr = np.geomspace(rough_law.pressure[0], rough_law.pressure[-1], 9)
+    pr = np.geomspace(rough_law.pressure.min(), rough_law.pressure.max(), 9)
     r = bem.law_ratios(law, law, pr)
     for key in ("p_at_h", "k_at_h", "a_at_h", "k_at_p", "a_at_p"):
         np.testing.assert_allclose(r[key], 1.0, rtol=1e-9)
@@ -405,7 +405,6 @@ def test_law_ratios_and_agreement(rough_law):
     h = rough_law.separation
     f = 1.0 + 0.5 * (h - h[0]) / (h[-1] - h[0])
     drift = NormalLaw.from_table(h, f * rough_law.pressure, rough_law.area_fraction)
-    pr = np.sort(pr)
     r = bem.law_ratios(drift, law, pr)
     lo, hi = bem.agreement_range(drift, law, pr, 0.1, ("p_at_h",))
     inside = (pr >= lo) & (pr <= hi)
