@@ -67,7 +67,8 @@ def figure(results, path):
                 a.set_xlabel("mean pressure p [MPa]")
             if j == 0:
                 a.set_ylabel(f"{surf}\nratio")
-    ax[0, 0].legend(fontsize=7)
+    for i in range(len(results)):
+        ax[i, 0].legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
@@ -118,7 +119,9 @@ def main(argv=None):
                              scatter=(float(np.max(b.pressure_std / b.pressure)),
                                       float(np.max(b.area_std / b.area_fraction)),
                                       float(np.max(b.stiffness_std / b.stiffness))),
-                             tangential=np.nanmean(b.tangential_ratio, axis=0),
+                             tangential=(np.mean(b.tangential_ratio, axis=0)
+                                         if np.isfinite(b.tangential_ratio).all()
+                                         else np.full(2, np.nan)),
                              area=(float(b.area_fraction.min()), float(b.area_fraction.max())),
                              time=(res["time_stat"], res["time_bem"]))
         if args.figdir:

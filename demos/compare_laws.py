@@ -272,12 +272,14 @@ def compare(source: dict, *, E_star=E_STAR, nu=NU, psi=0.35, tol=0.1, realisatio
                    ["h/sigma"] + [f"{n}: A/A0" for n in laws])
         print_rows(by_h, "Stiffness k [MPa/mm] vs separation",
                    ["h/sigma"] + [f"{n}: k [MPa/mm]" for n in laws])
-        print_rows(by_p, "Separation h/sigma vs load", ["p [MPa]"] + [f"{n}: h/sigma" for n in laws])
+        print_rows(by_p, "Separation h/sigma vs load",
+                   ["p [MPa]"] + [f"{n}: h/sigma" for n in laws])
         print_rows(by_p, "A/A0 vs load", ["p [MPa]"] + [f"{n}: A/A0" for n in laws])
         print_rows(by_p, "k [MPa/mm] vs load", ["p [MPa]"] + [f"{n}: k [MPa/mm]" for n in laws])
         print_rows(ratios, "Statistical / BEM (elasto-plastic vs saturated BEM)")
         b = bl["BEM elastic"]
-        print(f"\nBEM realisation scatter (1 std / mean) over the table: p {np.max(b.pressure_std / b.pressure):.2g}, "
+        print(f"\nBEM realisation scatter (1 std / mean) over the table: "
+              f"p {np.max(b.pressure_std / b.pressure):.2g}, "
               f"A/A0 {np.max(b.area_std / b.area_fraction):.2g}, "
               f"k {np.max(b.stiffness_std / b.stiffness):.2g} (standard error of the mean: "
               f"divide by sqrt({info['realisations']}))")

