@@ -568,6 +568,8 @@ class BEMCurves:
         E_star [MPa], nu [-], hardness [MPa] or None (elastic).
         rms_height: (n_r,) rms height of each map [mm]; build_time: (n_r,) wall time [s].
         cached: (n_r,) True where the result came from the disk cache.
+        refinement_error: with ``rtol``, the largest midpoint error of the last refinement
+            round (p, and k for elastic contact); None without refinement.
     """
 
     pressure: np.ndarray
@@ -584,6 +586,7 @@ class BEMCurves:
     rms_height: np.ndarray
     build_time: np.ndarray
     cached: np.ndarray
+    refinement_error: Optional[float] = None
 
     @property
     def n_realisations(self) -> int:
@@ -611,7 +614,7 @@ def default_cache_dir() -> Path:
 
 
 def _cache_key(z: np.ndarray, size, E_star, nu, hardness, pressures, backend, tol,
-               tangential) -> str:
+               tangential, rtol=None) -> str:
     h = hashlib.sha256()
     h.update(np.ascontiguousarray(z, dtype=np.float64).tobytes())
     meta = dict(v=_CACHE_VERSION, shape=list(z.shape), size=[float(s) for s in size],
@@ -619,6 +622,8 @@ def _cache_key(z: np.ndarray, size, E_star, nu, hardness, pressures, backend, to
                 hardness=None if hardness is None else float(hardness),
                 pressures=[float(p) for p in pressures], backend=backend, tol=float(tol),
                 tangential=bool(tangential))
+    if rtol is not None:            # (absent key: results cached before refinement existed)
+        meta["rtol"] = float(rtol)
     h.update(json.dumps(meta, sort_keys=True).encode())
     return h.hexdigest()[:32]
 
@@ -648,8 +653,8 @@ def _solver(backend: str, z, size, E_star, nu, hardness, tol) -> ContactSolver:
 def bem_curves(z, dx: float, dy: Optional[float] = None, *, E_star: float, nu: float,
                pressures, hardness: Optional[float] = None, backend: Optional[str] = None,
                boundary: str = "periodic", tol: Optional[float] = None,
-               tangential: bool = True, cache: bool = True,
-               cache_dir: Optional[os.PathLike] = None) -> BEMCurves:
+               tangential: bool = True, rtol: Optional[float] = None, max_pressures: int = 64,
+               cache: bool = True, cache_dir: Optional[os.PathLike] = None) -> BEMCurves:
     """Solve the rough contact of one height map at the given mean pressures.
 
     Args:
@@ -664,8 +669,15 @@ def bem_curves(z, dx: float, dy: Optional[float] = None, *, E_star: float, nu: f
         boundary: "periodic", "mirror" or "window" (:func:`check_height_map`).
         tol: solver tolerance (default 1e-10 for tamaas, 1e-8 for numpy, both relative).
         tangential: also compute the stick tangential stiffnesses (about doubles the cost).
+        rtol: None, or the accuracy the table must reach between its knots - the check of
+            ``NormalLaw.from_model``: every interval is solved at its geometric-mean pressure
+            and, where the table built from the other points misses p (and, elastic, k) there
+            by more than rtol, both halves are split again (the midpoints always become knots);
+            until all pass or ``max_pressures`` is reached (the worst remaining error is then in
+            ``BEMCurves.refinement_error``).
+        max_pressures: limit of the refinement.
         cache: read/write the result in the disk cache (keyed by the prepared heights, the grid,
-            E*, nu, H, the pressures, the backend, tol and the code version).
+            E*, nu, H, the pressures, the backend, tol, rtol and the code version).
         cache_dir: cache directory (default :func:`default_cache_dir`).
 
     Returns:
@@ -688,12 +700,16 @@ def bem_curves(z, dx: float, dy: Optional[float] = None, *, E_star: float, nu: f
     zp, diag = check_height_map(z, dx, dy, boundary=boundary)
     dx, dy = diag.spacing
     size = (zp.shape[0] * dx, zp.shape[1] * dy)
-    key = _cache_key(zp, size, E_star, nu, hardness, pressures, backend, tol, tangential)
+    if rtol is not None:
+        rtol = check_scalar("rtol", rtol, lo=1e-6, lo_open=False, hi=0.1)
+    key = _cache_key(zp, size, E_star, nu, hardness, pressures, backend, tol, tangential,
+                     rtol)
     path = Path(cache_dir or default_cache_dir()) / f"bem_{key}.npz"
     if cache and path.exists():
         with np.load(path, allow_pickle=False) as f:
             meta = json.loads(str(f["meta"]))
-            return BEMCurves(pressure=pressures, separation=f["separation"][None],
+            return BEMCurves(pressure=f["pressure"] if "pressure" in f else pressures,
+                             separation=f["separation"][None],
                              area_fraction=f["area_fraction"][None],
                              stiffness=f["stiffness"][None],
                              tangential_stiffness=f["tangential_stiffness"][None],
@@ -701,31 +717,73 @@ def bem_curves(z, dx: float, dy: Optional[float] = None, *, E_star: float, nu: f
                              E_star=E_star, nu=nu, hardness=hardness,
                              rms_height=np.array([diag.rms_height]),
                              build_time=np.array([meta["build_time"]]),
-                             cached=np.array([True]))
+                             cached=np.array([True]),
+                             refinement_error=meta.get("refinement_error"))
     t0 = time.perf_counter()
     solver = _solver(backend, zp, size, E_star, nu, hardness, tol)
     K = HalfSpace(zp.shape, size, E_star, nu)
-    n = pressures.size
-    d, a, k = np.empty(n), np.empty(n), np.empty(n)
-    kt = np.full((n, 2), np.nan)
-    p_field = None
-    for j, pm in enumerate(pressures):
-        p_field = solver.solve(pm, p_field)
-        d[j], a[j], k[j], kt[j, 0], kt[j, 1] = _post_process(zp, p_field, K, hardness,
-                                                             tangential)
+
+    def solve_all(pr):
+        n = pr.size
+        d, a, k = np.empty(n), np.empty(n), np.empty(n)
+        kt = np.full((n, 2), np.nan)
+        p_field = None
+        for j, pm in enumerate(pr):      # one BEM solve per pressure, warm-started in order
+            p_field = solver.solve(pm, p_field)
+            d[j], a[j], k[j], kt[j, 0], kt[j, 1] = _post_process(zp, p_field, K, hardness,
+                                                                 tangential)
+        return d, a, k, kt
+
+    d, a, k, kt = solve_all(pressures)
+    worst = None
+    if rtol is not None:
+        pressures, d, a, k, kt, worst = _refine(solve_all, pressures, d, a, k, kt, rtol,
+                                                hardness is None, int(max_pressures))
     elapsed = time.perf_counter() - t0
     out = BEMCurves(pressure=pressures, separation=d[None], area_fraction=a[None],
                     stiffness=k[None], tangential_stiffness=kt[None], backend=solver.name,
                     grid=tuple(zp.shape), size=size, E_star=E_star, nu=nu, hardness=hardness,
                     rms_height=np.array([diag.rms_height]), build_time=np.array([elapsed]),
-                    cached=np.array([False]))
+                    cached=np.array([False]), refinement_error=worst)
     if cache:
         path.parent.mkdir(parents=True, exist_ok=True)
         tmp = path.with_name(path.name + f".{os.getpid()}.tmp.npz")
-        np.savez(tmp, separation=d, area_fraction=a, stiffness=k, tangential_stiffness=kt,
-                 meta=json.dumps({"backend": solver.name, "build_time": elapsed}))
+        np.savez(tmp, pressure=pressures, separation=d, area_fraction=a, stiffness=k,
+                 tangential_stiffness=kt,
+                 meta=json.dumps({"backend": solver.name, "build_time": elapsed,
+                                  "refinement_error": worst}))
         os.replace(tmp, path)   # atomic: a concurrent reader never sees half a file
     return out
+
+
+def _refine(solve_all, p, d, a, k, kt, rtol, use_k, max_pressures):
+    """Midpoint checks and bisection of the pressure list (see :func:`bem_curves`, rtol)."""
+    todo = np.ones(p.size - 1, bool)          # intervals still to check
+    worst = 0.0
+    while todo.any():
+        if p.size + int(todo.sum()) > max_pressures:
+            break
+        i = np.flatnonzero(todo)
+        pm = np.sqrt(p[i] * p[i + 1])
+        dm, am, km, ktm = solve_all(pm)
+        o = np.argsort(d)                      # the table wants increasing h
+        law, _ = _law_from_data(d[o], p[o], k[o], a[o], use_k)
+        pl, kl, _ = law.evaluate(dm)
+        err = np.abs(pl / pm - 1)
+        if use_k:
+            err = np.maximum(err, np.abs(kl / km - 1))
+        worst = float(err.max())
+        fail = err > rtol
+        # insert the midpoints (solved anyway); the halves of failing intervals are checked next
+        pos = i + 1
+        p, d, a, k = (np.insert(v, pos, w) for v, w in ((p, pm), (d, dm), (a, am), (k, km)))
+        kt = np.insert(kt, pos, ktm, axis=0)
+        new_todo = np.zeros(p.size - 1, bool)
+        shifted = i + np.arange(i.size)        # index of interval i's left half after insertion
+        new_todo[shifted[fail]] = True
+        new_todo[shifted[fail] + 1] = True
+        todo = new_todo
+    return p, d, a, k, kt, worst
 
 
 # ----------------------------------------------------------------------------------------------
@@ -870,6 +928,7 @@ def law_from_curves(curves: BEMCurves) -> BEMLaw:
         "pressure_range": [float(p.min()), float(p.max())],
         "area_range": [float(a.min()), float(a.max())],
         "interpolation_error": _interpolation_error(h, p, k, a, use_k and "Hermite" in source),
+        "refinement_error": curves.refinement_error,
     }
     pk, kk, ak = law.evaluate(h)
     info["table_k_error"] = float(np.max(np.abs(kk / k - 1)))
@@ -921,7 +980,8 @@ def bem_normal_law(z, dx: float, dy: Optional[float] = None, *, E_star: float, n
                    pressures=None, area_range: Tuple[float, float] = (0.005, 0.3),
                    n_pressures: int = 16, hardness: Optional[float] = None,
                    backend: Optional[str] = None, boundary: str = "periodic",
-                   tol: Optional[float] = None, tangential: bool = True, cache: bool = True,
+                   tol: Optional[float] = None, tangential: bool = True,
+                   rtol: Optional[float] = None, cache: bool = True,
                    cache_dir: Optional[os.PathLike] = None) -> BEMLaw:
     """The BEM normal law of one height map (measured or synthetic).
 
@@ -934,6 +994,9 @@ def bem_normal_law(z, dx: float, dy: Optional[float] = None, *, E_star: float, n
         hardness: None (elastic) or the pressure cap H [MPa] (saturated, elasto-plastic).
         backend: None (default: "tamaas" for elastic, "numpy" for saturated), "tamaas", "numpy".
         boundary, tol, tangential, cache, cache_dir: see :func:`bem_curves`.
+        rtol: None, or refine the pressures until the table meets rtol at the interval
+            midpoints (:func:`bem_curves`; k carries pixel-level noise of about 0.5-1 % at
+            8 pixels per shortest wavelength, so rtol below that is not reachable).
 
     Returns:
         :class:`BEMLaw`; ``.normal`` is the NormalLaw for the FE layer. Its table spans the
@@ -946,7 +1009,7 @@ def bem_normal_law(z, dx: float, dy: Optional[float] = None, *, E_star: float, n
         pressures = default_pressures(E_star, diag.rms_slope, hardness, area_range, n_pressures)
     c = bem_curves(z, dx, dy, E_star=E_star, nu=nu, pressures=pressures, hardness=hardness,
                    backend=backend, boundary=boundary, tol=tol, tangential=tangential,
-                   cache=cache, cache_dir=cache_dir)
+                   rtol=rtol, cache=cache, cache_dir=cache_dir)
     return law_from_curves(c)
 
 
@@ -956,7 +1019,8 @@ def bem_law_from_moments(moments: SpectralMoments, *, E_star: float, nu: float =
                          area_range: Tuple[float, float] = (0.005, 0.3), n_pressures: int = 16,
                          hardness: Optional[float] = None, backend: Optional[str] = None,
                          tol: Optional[float] = None, tangential: bool = True,
-                         cache: bool = True, cache_dir: Optional[os.PathLike] = None) -> BEMLaw:
+                         rtol: Optional[float] = None, cache: bool = True,
+                         cache_dir: Optional[os.PathLike] = None) -> BEMLaw:
     """The BEM law of a surface known only by its spectral moments, with realisation scatter.
 
     Gaussian realisations of the spectrum fitted by :func:`rough_contact.spectrum.fit_spectrum`
@@ -965,8 +1029,9 @@ def bem_law_from_moments(moments: SpectralMoments, *, E_star: float, nu: float =
 
     Args:
         moments: :class:`SpectralMoments` (x = grain direction).
-        E_star, nu, hardness, backend, tol, tangential, cache, cache_dir: as in
-            :func:`bem_normal_law`.
+        E_star, nu, hardness, backend, tol, tangential, rtol, cache, cache_dir: as in
+            :func:`bem_normal_law` (with rtol the first realisation chooses the pressures, the
+            others are solved at the same ones).
         n_realisations: number of realisations (seeds seed, seed + 1, ...), >= 1.
         pixels_per_wavelength: pixels per shortest wavelength of the spectrum (grid study in
             docs/bem.md).
@@ -991,8 +1056,10 @@ def bem_law_from_moments(moments: SpectralMoments, *, E_star: float, nu: float =
         zr = spec.realisation((nx, ny), (Lx, Ly), seed + r)
         curves.append(bem_curves(zr, Lx / nx, Ly / ny, E_star=E_star, nu=nu,
                                  pressures=pressures, hardness=hardness, backend=backend,
-                                 tol=tol, tangential=tangential, cache=cache,
+                                 tol=tol, tangential=tangential,
+                                 rtol=rtol if r == 0 else None, cache=cache,
                                  cache_dir=cache_dir))
+        pressures = curves[0].pressure
     out = law_from_curves(BEMCurves.stack(curves))
     out.info.update({"spectrum": {"C_mm4": spec.C, "q_l": spec.q_l, "q_r": spec.q_r,
                                   "q_s": spec.q_s, "hurst": spec.hurst, "gx": spec.gx,

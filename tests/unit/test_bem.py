@@ -477,3 +477,27 @@ def test_resolution_check(rough, tmp_path):
                                  cache_dir=tmp_path)
     assert r["factor"] == 2 and r["coarse"].curves.grid == (z.shape[0] // 2, z.shape[1] // 2)
     assert 0 < r["p"] < r["a"] and r["p"] < 0.05
+
+
+def test_refinement_meets_rtol(rough, tmp_path):
+    """rtol: interval midpoints are solved and split until the table meets rtol there."""
+    z, dx, dy = rough
+    pr = rough_pressures(z, dx, 4)
+    kw = dict(E_star=E_STAR, nu=NU, backend="numpy", tangential=False, cache_dir=tmp_path)
+    plain = bem.bem_curves(z, dx, dy, pressures=pr, **kw)
+    ref = bem.bem_curves(z, dx, dy, pressures=pr, rtol=0.02, **kw)
+    assert ref.pressure.size > pr.size and set(pr) <= set(ref.pressure)
+    assert np.all(np.diff(ref.pressure) > 0) and ref.refinement_error <= 0.02
+    # the refined table against BEM solves it has never seen (new midpoints): p within rtol
+    # (k there also carries the BEM stiffness's own pixel-level noise, up to ~3 % at the
+    # lightest load of this coarse 90^2 map, so it is not a test of the interpolation)
+    law = bem.law_from_curves(ref).normal
+    mids = np.sqrt(ref.pressure[:-1] * ref.pressure[1:])
+    check = bem.bem_curves(z, dx, dy, pressures=mids, **kw)
+    p, _, _ = law.evaluate(check.separation[0])
+    assert np.max(np.abs(p / mids - 1)) < 0.02
+    assert plain.refinement_error is None
+    again = bem.bem_curves(z, dx, dy, pressures=pr, rtol=0.02, **kw)
+    assert again.cached[0] and np.array_equal(again.pressure, ref.pressure)
+    capped = bem.bem_curves(z, dx, dy, pressures=pr, rtol=1e-6, max_pressures=9, **kw)
+    assert capped.pressure.size <= 9
