@@ -14,7 +14,7 @@ cd "$here"
 DEB_PACKAGES=(python3-dolfinx python3-gmsh python3-scipy python3-pytest python3-matplotlib
               python3-h5py python3-venv python3-wheel libopenblas0-pthread openmpi-bin)
 VENV="$here/.venv"
-TEST_EXTRAS="topography"
+TEST_EXTRAS="bem,topography"
 PY="$VENV/bin/python"
 
 setup() {

@@ -654,18 +654,23 @@ class NormalLaw:
         return cls._assemble(h, q, -k / p, la, _limited_slopes(h, la), True, rtol, info)
 
     @classmethod
-    def from_table(cls, h, p, a=None) -> "NormalLaw":
+    def from_table(cls, h, p, a=None, k=None) -> "NormalLaw":
         """Build the law from tabulated data (e.g. measured), interpolated monotonically.
 
         ``ln p`` is interpolated by monotone PCHIP (Fritsch-Butland slopes, as
         :class:`scipy.interpolate.PchipInterpolator`), so p is non-increasing and C1 and k is the
-        exact derivative of the interpolant; ``ln a`` likewise when a is given.
+        exact derivative of the interpolant; ``ln a`` likewise when a is given. When the data
+        include the stiffness k (e.g. from boundary elements), ``ln p`` is instead the cubic
+        Hermite interpolant with slopes ``-k/p`` (fourth-order accurate instead of PCHIP's
+        first-order slopes); every interval must then be monotone (Fritsch-Carlson region).
 
         Args:
             h: (n,) separations [mm], finite, strictly increasing, n >= 3.
             p: (n,) pressures [MPa], finite, > 0, strictly decreasing.
             a: optional (n,) area fractions A/A0 in (0, 1], non-increasing. Without it,
                 ``evaluate`` returns a == 0 and ``has_area`` is False.
+            k: optional (n,) stiffnesses -dp/dh [MPa/mm], finite, > 0, used as Hermite slope
+                data (the table's k then equals them at the knots).
 
         Below ``h[0]`` the stiff continuation applies, beyond ``h[-1]`` the cubic taper to zero
         over L = 3 p_end/k_end (so p == 0 from ``h_max = h[-1] + L``): end the data where the
@@ -694,7 +699,23 @@ class NormalLaw:
             raise ValueError(f"table p must be strictly decreasing in h: p[{j}] = {p[j]!r}, "
                              f"p[{j + 1}] = {p[j + 1]!r} MPa")
         q = np.log(p)
-        dq = np.minimum(PchipInterpolator(h, q).derivative()(h), 0.0)
+        if k is not None:
+            k = np.array(k, dtype=float).ravel()
+            if k.size != h.size or not np.isfinite(k).all() or np.any(k <= 0):
+                raise ValueError(f"table k must have {h.size} finite entries > 0 MPa/mm, got "
+                                 f"{k.size} entries (min {np.min(k) if k.size else None!r})")
+            dq = -k / p
+            dxs = np.diff(h)
+            mono = _monotone_hermite(np.diff(q), dq[:-1] * dxs, dq[1:] * dxs)
+            if not mono.all():
+                j = int(np.flatnonzero(~mono)[0])
+                raise ValueError(
+                    f"table k is inconsistent with p on [h[{j}], h[{j + 1}]] = [{h[j]!r}, "
+                    f"{h[j + 1]!r}] mm: the Hermite interpolant of ln p would not be monotone "
+                    f"(k = {k[j]!r}, {k[j + 1]!r} MPa/mm, secant "
+                    f"{-(p[j + 1] - p[j]) / dxs[j]!r} MPa/mm); tabulate more densely or omit k")
+        else:
+            dq = np.minimum(PchipInterpolator(h, q).derivative()(h), 0.0)
         if dq[-1] == 0.0:
             # PCHIP zeroes a one-sided end slope of the wrong sign; the taper needs k > 0 at the
             # table end: half the last secant keeps the segment monotone (Fritsch-Carlson region

@@ -1,0 +1,30 @@
+"""The punch demo with the statistical and the BEM normal law, small size, serial and on 2 ranks.
+
+demos/demo_punch_bem_vs_statistical.py: both laws load the punch with force balance, from the
+seated state, inside both tables."""
+from __future__ import annotations
+
+import os
+import sys
+
+import numpy as np
+from mpi4py import MPI
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "demos"))
+import demo_punch_bem_vs_statistical as demo  # noqa: E402
+
+
+def test_punch_bem_vs_statistical_small(tmp_path, monkeypatch):
+    monkeypatch.setenv("ROUGH_CONTACT_CACHE", str(MPI.COMM_WORLD.bcast(str(tmp_path), root=0)))
+    out = demo.main(small=True, backend="numpy", verbose=False)
+    assert set(out) == {"statistical", "BEM"}
+    for rows in out.values():
+        assert len(rows) == 2
+        for r in rows:
+            assert r["force_error"] < 1e-8
+            assert r["below"] == 0 and r["beyond"] == 0          # inside both tables
+            assert all(np.isfinite(v) for v in r.values())
+        # the first increment is the seated state: the rough layer is not compressed on average
+        assert abs(rows[0]["closure"]) < 0.1 * abs(rows[1]["closure"])
+        assert rows[1]["approach"] > rows[0]["approach"] > 0
+        assert rows[1]["dissipation"] >= 0
