@@ -95,3 +95,21 @@ def test_plot_interface_pressure(tmp_path):
          "--out", png, "--mesh-size", "20", "--contact-size", "5", "--order", "1",
          "--steps", "2"], tmp_path)
     assert png.stat().st_size > 0
+
+
+def test_compare_laws(tmp_path):
+    out = run([DEMOS / "compare_laws.py", "--surface", "anisotropic", "--no-plastic",
+               "--realisations", "1", "--ppw", "3", "--pressures", "4", "--backend", "numpy",
+               "--out", tmp_path / "cmp"], tmp_path)
+    assert "BEM" in out
+
+
+def test_demo_punch_bem_vs_statistical(tmp_path):
+    env_cache = tmp_path / "cache"
+    os.environ["ROUGH_CONTACT_CACHE"] = str(env_cache)
+    try:
+        out = run([DEMOS / "demo_punch_bem_vs_statistical.py", "--small", "--backend", "numpy",
+                   "--outdir", tmp_path / "pb"], tmp_path)
+    finally:
+        del os.environ["ROUGH_CONTACT_CACHE"]
+    assert "secant punch stiffness" in out

@@ -1,22 +1,18 @@
 """The punch demo with the statistical and the BEM normal law, small size, serial and on 2 ranks.
 
-demos/demo_punch_bem_vs_statistical.py: both laws load the punch with force balance, from the
+rough_contact.scenes.punch_bem (demos/demo_punch_bem_vs_statistical.py): both laws load the punch with force balance, from the
 seated state, inside both tables."""
 from __future__ import annotations
-
-import os
-import sys
 
 import numpy as np
 from mpi4py import MPI
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "demos"))
-import demo_punch_bem_vs_statistical as demo  # noqa: E402
+from rough_contact.scenes import punch_bem as demo
 
 
 def test_punch_bem_vs_statistical_small(tmp_path, monkeypatch):
     monkeypatch.setenv("ROUGH_CONTACT_CACHE", str(MPI.COMM_WORLD.bcast(str(tmp_path), root=0)))
-    out = demo.main(small=True, backend="numpy", verbose=False)
+    out = demo.run(small=True, backend="numpy", verbose=False)
     assert set(out) == {"statistical", "BEM"}
     for rows in out.values():
         assert len(rows) == 2

@@ -1,0 +1,159 @@
+"""The flat punch with the statistical and the boundary-element normal law on the same surface.
+
+The quarter punch of :mod:`rough_contact.scenes.flat_punch` (E = 200 GPa, nu = 0.25, friction
+case (b)) is loaded twice on the same rough surface, once with the statistical elastic law
+(asperity sums) and once with the BEM law of that surface (:mod:`rough_contact.bem`: exact
+elastic contact of Gaussian realisations of the surface's spectrum). Everything else is
+identical, so the differences are the effect of the normal law: approach of the loaded patch,
+interface closure, int k dA, real contact area, dissipation. The default load is a bolted-joint
+level 50 kN (nominal 125 MPa), where the contact pressures lie inside the BEM table
+(``docs/bem.md``). Library code (no petsc4py.init, no sys.argv). Units: mm, N, MPa.
+"""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+import ufl
+from dolfinx import fem
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from rough_contact.scenes import flat_punch as punch
+from rough_contact.solver.loading import load_path, load_unload_factors
+
+__all__ = ["build_laws", "run_with_law", "run"]
+
+
+# ## The two normal laws (built on rank 0, copied to the others)
+def build_laws(comm, surface, realisations, ppw, small, backend=None):
+    """{"statistical": NormalLaw, "BEM": NormalLaw} and the BEMLaw info. Collective."""
+    laws = info = None
+    if comm.rank == 0:
+        import warnings
+
+        from rough_contact import bem
+        from rough_contact.interface.normal import NormalLaw
+        from rough_contact.spectrum import example_surfaces
+
+        m, shape = example_surfaces()[surface]
+        E_star = punch.effective_modulus(punch.E, punch.NU, punch.E, punch.NU)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", UserWarning)    # isotropic: model-validity warning
+            stat = NormalLaw.elastic(m, E_star)
+            b = bem.bem_law_from_moments(
+                m, E_star=E_star, nu=punch.NU, n_realisations=2 if small else realisations,
+                pixels_per_wavelength=3.0 if small else ppw, n_pressures=6 if small else 14,
+                area_range=(0.002, 0.45), tangential=False, backend=backend)
+        laws = {"statistical": stat, "BEM": b.normal}
+        info = dict(b.info)
+    return comm.bcast(laws, root=0), comm.bcast(info, root=0)
+
+
+# ## One run of the punch with a given normal law
+def run_with_law(comm, normal, force, steps, case, mesh_size, contact_size, order, verbose):
+    """Load to ``force`` in ``steps`` increments; per-increment figures (identical on ranks)."""
+    m = punch.build(comm, mesh_size, contact_size, order, case=case, normal_law="elastic",
+                    steps=steps, normal=normal, total_force=float(force))
+    scene, problem, solver, interface, law = m.scene, m.problem, m.solver, m.interface, m.law
+    ds = ufl.Measure("ds", domain=scene.mesh, subdomain_data=scene.facet_tags)
+    load_ds = ds(scene.tag("load"))
+    uz_form = fem.form(problem.u[2] * load_ds)
+    area_load = comm.allreduce(fem.assemble_scalar(fem.form(
+        fem.Constant(scene.mesh, PETSc.ScalarType(1.0)) * load_ds)), op=MPI.SUM)
+    rows = []
+    for inc in load_path(problem, solver, load_unload_factors(steps, 0), verbose=verbose):
+        pf = interface.point_fields()
+        h = law.h0 + pf.gap
+        _, k, _ = law.normal.evaluate(h)
+        w = pf.weight
+        glob = lambda v: comm.allreduce(float(v), op=MPI.SUM)  # noqa: E731
+        area = glob(w.sum())
+        rows.append(dict(
+            force=-inc.applied_force[2] * 4.0,                 # full punch [N]
+            approach=-glob(fem.assemble_scalar(uz_form)) / area_load,
+            closure=-glob(np.dot(pf.gap, w)) / area,          # mean compression of the layer
+            k_int=4.0 * glob(np.dot(k, w)),                   # full punch [N/mm]
+            real_area=4.0 * glob(np.dot(pf.area_fraction, w)),
+            dissipation=4.0 * interface.dissipation(),
+            below=comm.allreduce(law.normal.count_below_validity(h), op=MPI.SUM),
+            beyond=comm.allreduce(int(np.count_nonzero(h > law.normal.h_table_end)),
+                                  op=MPI.SUM),
+            p_max=comm.allreduce(float(pf.pressure.max(initial=0.0)), op=MPI.MAX),
+            force_error=abs(inc.contact_force[2] + inc.applied_force[2])
+            / abs(inc.applied_force[2]),
+            n_points=interface.n_points_global))
+    solver.destroy()
+    return rows, problem.num_dofs
+
+
+def run(surface="anisotropic", force=50e3, steps=8, case="b", mesh_size=20.0, contact_size=2.0,
+         order=2, realisations=8, ppw=8.0, small=False, backend=None, outdir=None,
+         comm=MPI.COMM_WORLD, verbose=True):
+    """Run both laws; print the comparison; return dict(law -> rows). Collective."""
+    t0 = MPI.Wtime()
+    if small:
+        mesh_size, contact_size, order, steps = 40.0, 5.0, 1, 2
+    laws, info = build_laws(comm, surface, realisations, ppw, small, backend)
+    PETSc.Sys.Print(f"Normal laws of the '{surface}' surface: statistical elastic "
+                    f"({laws['statistical'].n_intervals} intervals) and BEM ({info['backend']}, "
+                    f"{info['realisations']} realisations of {info['grid'][0]}x{info['grid'][1]} "
+                    f"px, A/A0 {info['area_range'][0]:.3g}-{info['area_range'][1]:.3g}, "
+                    f"p {info['pressure_range'][0]:.3g}-{info['pressure_range'][1]:.3g} MPa); "
+                    f"built in {MPI.Wtime() - t0:.1f} s", comm=comm)
+    out = {}
+    for name, normal in laws.items():
+        rows, ndofs = run_with_law(comm, normal, force, steps, case, mesh_size, contact_size, order,
+                          verbose=False)
+        out[name] = rows
+        PETSc.Sys.Print(f"  {name:12s}: {ndofs} DOFs, {rows[-1]['n_points']} interface points, "
+                        f"{len(rows)} increments, max force error "
+                        f"{max(r['force_error'] for r in rows):.1e}", comm=comm)
+    s, b = out["statistical"], out["BEM"]
+    PETSc.Sys.Print(f"\nFlat punch, '{surface}' surface, friction case ({case}), loading to "
+                    f"{force:g} N in {steps} increments (seated at the first); full-punch "
+                    "figures\n", comm=comm)
+    hdr = (f"{'F [N]':>9s} | {'approach [um]':>21s} | {'closure [um]':>21s} | "
+           f"{'int k dA [N/mm]':>23s} | {'real area [mm2]':>19s}")
+    PETSc.Sys.Print(hdr + "\n" + f"{'':9s} | {'stat':>6s} {'BEM':>6s} {'diff':>7s} | "
+                    f"{'stat':>6s} {'BEM':>6s} {'diff':>7s} | {'stat':>7s} {'BEM':>7s} "
+                    f"{'diff':>7s} | {'stat':>5s} {'BEM':>5s} {'diff':>7s}", comm=comm)
+    rel = lambda x, y: (y - x) / x if x else float("nan")  # noqa: E731
+    for rs, rb in zip(s, b):
+        PETSc.Sys.Print(
+            f"{rs['force']:9.4g} | {rs['approach'] * 1e3:6.3f} {rb['approach'] * 1e3:6.3f} "
+            f"{rel(rs['approach'], rb['approach']):+7.1%} | {rs['closure'] * 1e3:6.3f} "
+            f"{rb['closure'] * 1e3:6.3f} {rel(rs['closure'], rb['closure']):+7.1%} | "
+            f"{rs['k_int']:7.3g} {rb['k_int']:7.3g} {rel(rs['k_int'], rb['k_int']):+7.1%} | "
+            f"{rs['real_area']:5.3g} {rb['real_area']:5.3g} "
+            f"{rel(rs['real_area'], rb['real_area']):+7.1%}", comm=comm)
+    # secant stiffness of the whole punch over the last increment
+    ks = [(r[-1]["force"] - r[-2]["force"]) / (r[-1]["approach"] - r[-2]["approach"])
+          for r in (s, b)]
+    PETSc.Sys.Print(
+        f"\nsecant punch stiffness dF/d(approach), last increment: statistical {ks[0]:.4g} N/mm, "
+        f"BEM {ks[1]:.4g} N/mm ({rel(ks[0], ks[1]):+.1%})\n"
+        f"dissipation D at {force:g} N: statistical {s[-1]['dissipation']:.4g} N mm, BEM "
+        f"{b[-1]['dissipation']:.4g} N mm ({rel(s[-1]['dissipation'], b[-1]['dissipation']):+.1%})"
+        f"\nlargest contact pressure: statistical {s[-1]['p_max']:.4g} MPa, BEM "
+        f"{b[-1]['p_max']:.4g} MPa; points below the table (continuation) / beyond it (taper) "
+        f"at the peak: statistical {s[-1]['below']}/{s[-1]['beyond']}, BEM "
+        f"{b[-1]['below']}/{b[-1]['beyond']} of {s[-1]['n_points']}\n"
+        f"wall time {MPI.Wtime() - t0:.1f} s", comm=comm)
+    if outdir and comm.rank == 0:
+        import csv
+
+        os.makedirs(outdir, exist_ok=True)
+        with open(os.path.join(outdir, "history.csv"), "w", newline="") as f:
+            w = csv.writer(f)
+            keys = list(s[0])
+            w.writerow(["law"] + keys)
+            for name, rows in out.items():
+                for r in rows:
+                    w.writerow([name] + [r[k] for k in keys])
+    for rows in out.values():
+        assert max(r["force_error"] for r in rows) < 1e-6, "force balance violated"
+    return out
+
+
