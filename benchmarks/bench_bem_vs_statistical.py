@@ -2,7 +2,7 @@
 
 For each surface of rough_contact.spectrum.example_surfaces (isotropic Gaussian, strongly
 anisotropic, broadband self-affine; optionally the paper's surface) this runs
-demos/compare_laws.py's ``compare`` (statistical elastic, GW and - with ``--plastic`` - the
+rough_contact.law_comparison's ``compare`` (statistical elastic, GW and - with ``--plastic`` - the
 elasto-plastic law against the elastic / saturated BEM law, realisations averaged at equal
 separation) and prints and saves the ratios statistical/BEM of p, A/A0 and k at equal separation
 (and A/A0, k at equal load) over the load range, with the load ranges of agreement.
@@ -20,14 +20,11 @@ from __future__ import annotations
 import argparse
 import csv
 import os
-import sys
 
 import numpy as np
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "demos"))
-import compare_laws  # noqa: E402
-
-from rough_contact.spectrum import example_surfaces  # noqa: E402
+from rough_contact import law_comparison as compare_laws
+from rough_contact.spectrum import example_surfaces
 
 PPW = {"isotropic": 8.0, "anisotropic": 8.0, "self-affine": 4.0, "paper": 4.0}
 SE = {"p_at_h": "se_p", "a_at_h": "se_a", "k_at_h": "se_k", "a_at_p": "se_a", "k_at_p": "se_k"}
