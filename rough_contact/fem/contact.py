@@ -90,6 +90,8 @@ class InterfaceSummary:
         max_slip: largest |(s_x, s_y)| [mm].
         max_plastic_slip: largest |plastic slip| of the trial state [mm].
         dissipation: committed accumulated frictional dissipation int D dA [N mm].
+        n_beyond_validity: points where the law reports evaluation outside its model's range
+            (``LawResult.beyond_validity``; 0 for a law without such a limit).
     """
 
     n_points: int
@@ -103,6 +105,7 @@ class InterfaceSummary:
     max_slip: float
     max_plastic_slip: float
     dissipation: float
+    n_beyond_validity: int = 0
 
 
 @dataclass(frozen=True)
@@ -676,7 +679,8 @@ class ContactInterface:
         sums = np.concatenate([force, [
             float(np.dot(res.area_fraction, w)), float(w.sum()), float(w[res.contact].sum()),
             float(w[res.slipping].sum()), float(np.dot(self.history.dissipated, w)),
-            float(res.contact.sum()), float(res.slipping.sum())]])
+            float(res.contact.sum()), float(res.slipping.sum()),
+            0.0 if res.beyond_validity is None else float(res.beyond_validity.sum())]])
         sums = self.comm.allreduce(sums, op=MPI.SUM)
         slip = np.linalg.norm(self._last_jump[:, 1:], axis=1)
         plastic = np.linalg.norm(self.history.trial.plastic_slip, axis=1)
@@ -687,7 +691,7 @@ class ContactInterface:
             contact_force=sums[:3], real_area=float(sums[3]), nominal_area=float(sums[4]),
             contact_area=float(sums[5]), slipping_area=float(sums[6]),
             max_slip=float(maxima[0]), max_plastic_slip=float(maxima[1]),
-            dissipation=float(sums[7]))
+            dissipation=float(sums[7]), n_beyond_validity=int(sums[10]))
 
     def slip_stats(self) -> InterfaceSummary:
         """Same as :meth:`summary` (the name older callers use)."""
