@@ -200,7 +200,15 @@ class ContactInterface:
         rigid_plane: for ``second_tag=None``: (point (3,), unit normal (3,) pointing towards the
             first body) [mm]; None = a plane tangent to the first surface at every point.
         grain_direction: (3,) global direction projected on the facet to give the local x axis.
-        quadrature_degree: degree (integer >= 0) of the facet quadrature rule.
+        quadrature_degree: degree (integer >= 0) of the facet quadrature rule (Gauss).
+        quadrature: ``"gauss"`` (default: Gauss points of ``quadrature_degree``) or
+            ``"vertex"``: the facet's vertices with equal weights (nodal, "lumped" integration;
+            P1/Q1 spaces only). With the vertex rule the law is evaluated once per surface node
+            (the facets sharing a node see the same jump) and every node carries one
+            constraint; Gauss rules put 3 (P1, degree 2) or more points per facet, i.e. about
+            6 constraints per node of a triangulated surface, which a stiff penalty over-
+            constrains: pressures and stick/slip then depend on the penalty and the rule
+            (docs/solver.md, the Coulomb punch). ``quadrature_degree`` is ignored.
         bcs: Dirichlet conditions whose DOFs the interface must not touch (also
             ``set_dirichlet_dofs``).
         match_tolerance: vertex matching tolerance relative to the facet size [-], > 0.
@@ -227,6 +235,7 @@ class ContactInterface:
         rigid_plane: Optional[RigidPlane] = None,
         grain_direction: Sequence[float] = (1.0, 0.0, 0.0),
         quadrature_degree: int = 2,
+        quadrature: str = "gauss",
         bcs: Sequence[dolfinx.fem.DirichletBCMetaClass] = (),
         match_tolerance: float = 1e-6,
     ):
@@ -234,10 +243,11 @@ class ContactInterface:
         self.V = V
         self.law = law
         grain, degree = _check_arguments(V, law, first_tag, second_tag, rigid_plane,
-                                         quadrature_degree, grain_direction, match_tolerance)
+                                         quadrature_degree, grain_direction, match_tolerance,
+                                         quadrature)
         self.first_tag, self.second_tag = first_tag, second_tag
         n_owned_facets = _facet_connectivity(V.mesh)
-        rule = _FacetRule.create(V.mesh, degree)
+        rule = _FacetRule.create(V.mesh, degree, vertex=quadrature == "vertex")
         geo1 = _FacetGeometry(V, _owned_tagged_facets(facet_tags, first_tag, n_owned_facets,
                                                       self.comm))
         self._facets1 = geo1.facets
@@ -734,7 +744,8 @@ class ContactInterface:
 
 
 def _check_arguments(V, law, first_tag, second_tag, rigid_plane, quadrature_degree,
-                     grain_direction, match_tolerance) -> tuple[np.ndarray, int]:
+                     grain_direction, match_tolerance, quadrature="gauss"
+                     ) -> tuple[np.ndarray, int]:
     """Validate ContactInterface's arguments; return the grain direction (3,) and the degree."""
     missing = [m for m in ("initial_state", "evaluate") if not callable(getattr(law, m, None))]
     if missing or not isinstance(law, InterfaceLawProtocol):
@@ -767,6 +778,11 @@ def _check_arguments(V, law, first_tag, second_tag, rigid_plane, quadrature_degr
         raise ValueError(f"quadrature_degree = {quadrature_degree!r} is invalid: it must be an "
                          "integer >= 0")
     check_scalar("match_tolerance", match_tolerance, lo=0.0)
+    if quadrature not in ("gauss", "vertex"):
+        raise ValueError(f"quadrature = {quadrature!r} is invalid: it must be 'gauss' or 'vertex'")
+    if quadrature == "vertex" and element.degree != 1:
+        raise ValueError(f"quadrature = 'vertex' needs a degree-1 space (P1/Q1), got degree "
+                         f"{element.degree}: use a Gauss rule for P2/Q2")
     grain = np.asarray(grain_direction, dtype=float)
     if grain.shape != (3,) or not np.all(np.isfinite(grain)) or np.linalg.norm(grain) == 0:
         raise ValueError(f"grain_direction = {grain_direction!r} must be a nonzero 3-vector")
@@ -815,11 +831,19 @@ class _FacetRule:
     normals: np.ndarray
 
     @classmethod
-    def create(cls, msh, degree: int) -> _FacetRule:
+    def create(cls, msh, degree: int, vertex: bool = False) -> _FacetRule:
+        """Gauss rule of ``degree`` on the reference facet, or (``vertex``) its vertices with
+        equal weights (exact for linear functions on triangles, bilinear ones on
+        quadrilaterals: the P1/Q1 facet fields)."""
         cell = _basix_cell(msh)
         facet_cell = _CELLS[msh.topology.cell_type][1]
         ref_facets = np.array(basix.topology(cell)[2])  # (n_lf, nv)
-        xi, w_ref = basix.make_quadrature(facet_cell, degree)
+        if vertex:
+            xi = np.asarray(basix.geometry(facet_cell), dtype=float)
+            area = 0.5 if facet_cell == basix.CellType.triangle else 1.0
+            w_ref = np.full(len(xi), area / len(xi))
+        else:
+            xi, w_ref = basix.make_quadrature(facet_cell, degree)
         lam = _vertex_weights(facet_cell, xi)  # (nq, nv)
         fv_ref = basix.geometry(cell)[ref_facets]  # (n_lf, nv, 3)
         X_lf = np.einsum("qi,fid->fqd", lam, fv_ref)  # (n_lf, nq, 3) points per local facet

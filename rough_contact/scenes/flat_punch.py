@@ -191,8 +191,11 @@ def build(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2, load_h
           law="rough", case="b", normal_law="elasto-plastic", steps=16, prefix="rc_",
           dof_threshold=100_000, quadrature_degree=None, normal=None, seating_steps=None,
           cell_type="tetrahedron", *, punch_scene=None, total_force=TOTAL_FORCE,
-          solver_defaults=None):
+          solver_defaults=None, quadrature="gauss"):
     """Mesh, law, interface, problem and solver of the quarter punch. Collective.
+
+    ``quadrature`` is the interface rule (``"gauss"`` of ``quadrature_degree``, default 2 x
+    order, or ``"vertex"``: nodal, P1 only; see ``ContactInterface``).
 
     ``punch_scene`` reuses a :class:`PunchScene` of :func:`quarter_punch` (mesh sizes, order
     and cell type are then taken from it); ``total_force`` is the full punch's force at load
@@ -232,7 +235,8 @@ def build(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2, load_h
     first, second = scene.contact_pair
     qdeg = quadrature_degree if quadrature_degree is not None else 2 * order
     interface = ContactInterface(V, scene.facet_tags, first, second, law=interface_law,
-                                 grain_direction=(1.0, 0.0, 0.0), quadrature_degree=qdeg, bcs=bcs)
+                                 grain_direction=(1.0, 0.0, 0.0), quadrature_degree=qdeg,
+                                 quadrature=quadrature, bcs=bcs)
     materials = {scene.tag("punch"): Material(E, NU), scene.tag("foundation"): Material(E, NU)}
     loads = [SurfaceLoad(scene.tag("load"), force=[0.0, 0.0, -quarter_force])]
     problem = ContactProblem(V, materials, bcs, loads, cell_tags=scene.cell_tags,

@@ -54,6 +54,7 @@ __all__ = ["Increment", "LoadStepError", "ModelValidityError", "ModelValidityWar
            "load_unload_factors"]
 
 VALIDITY_POLICIES = ("warn", "error", "ignore")
+PREDICTORS = ("secant", "none")
 
 
 class ModelValidityWarning(UserWarning):
@@ -175,7 +176,8 @@ def _print_increment(inc: Increment) -> None:
 
 def load_path(problem: ContactProblem, solver: SNESSolver, factors: Iterable[float], *,
               min_increment: float = 1e-4, max_growth: float = 2.0,
-              verbose: bool = True, validity: str = "warn") -> Iterator[Increment]:
+              verbose: bool = True, validity: str = "warn",
+              predictor: str = "secant") -> Iterator[Increment]:
     """Follow ``factors`` with Newton solves; yield after each converged, committed step.
 
     Args:
@@ -190,6 +192,16 @@ def load_path(problem: ContactProblem, solver: SNESSolver, factors: Iterable[flo
         validity: what to do when a converged step has interface points outside the law's
             range of validity: ``"warn"`` (a :class:`ModelValidityWarning`), ``"error"`` (raise
             :class:`ModelValidityError`) or ``"ignore"`` (count only).
+        predictor: initial guess of each Newton solve. ``"secant"`` (default) extrapolates
+            linearly in the load factor from the last two converged states,
+            u0 = u_n + (lam - lam_n) / (lam_n - lam_{n-1}) (u_n - u_{n-1}), while the load keeps
+            its direction; for the first step and at a load reversal it starts from u_n
+            (retracing the loading path would put every slipping point of a frictional
+            interface on the wrong side of its cone). ``"none"`` always starts from u_n. The
+            interface history is the committed one either way: the converged result does not
+            depend on the choice (to the Newton tolerance), the iteration count does
+            (docs/coulomb.md: -67 % / -52 % on the Coulomb punch at mu = 0.2 / 0.5, -19 % on
+            the rough punch).
 
     Yields:
         :class:`Increment` per converged step.
@@ -202,6 +214,9 @@ def load_path(problem: ContactProblem, solver: SNESSolver, factors: Iterable[flo
     """
     check_scalar("min_increment", min_increment, lo=0.0)
     check_scalar("max_growth", max_growth, lo=1.0, lo_open=False)
+    if predictor not in PREDICTORS:
+        raise ValueError(f"predictor = {predictor!r} is invalid: it must be one of "
+                         f"{', '.join(PREDICTORS)}")
     if validity not in VALIDITY_POLICIES:
         raise ValueError(f"validity = {validity!r} is invalid: it must be one of "
                          f"{', '.join(VALIDITY_POLICIES)}")
@@ -210,6 +225,7 @@ def load_path(problem: ContactProblem, solver: SNESSolver, factors: Iterable[flo
     interface = problem.interface
     u_committed = problem.u.vector.copy()
     lam_committed = problem.load_factor
+    u_previous, lam_previous = None, None     # the converged state before u_committed
     step = 0
     for i, target in enumerate(factors):
         target = check_scalar(f"load factor {i} of the load path", target)
@@ -223,12 +239,25 @@ def load_path(problem: ContactProblem, solver: SNESSolver, factors: Iterable[flo
                 delta = target - lam_committed
             lam = lam_committed + delta
             problem.set_load_factor(lam)
+            if (predictor == "secant" and u_previous is not None
+                    and (lam - lam_committed) * (lam_committed - lam_previous) > 0.0):
+                # u0 = u_n + r (u_n - u_{n-1}), r = (lam - lam_n) / (lam_n - lam_{n-1})
+                r = (lam - lam_committed) / (lam_committed - lam_previous)
+                u_committed.copy(problem.u.vector)
+                problem.u.vector.axpy(r, u_committed)
+                problem.u.vector.axpy(-r, u_previous)
+                problem.u.x.scatter_forward()
             ok, result, failure = _attempt(solver, comm)
             if ok:
                 # Re-evaluate at the converged iterate so the trial history matches it.
                 problem.F(None, solver.x, problem.b)
                 if interface is not None:
                     interface.commit()
+                if predictor == "secant":
+                    if u_previous is None:
+                        u_previous = u_committed.duplicate()
+                    u_committed.copy(u_previous)
+                    lam_previous = lam_committed
                 problem.u.vector.copy(u_committed)
                 lam_committed = lam
                 step += 1
