@@ -290,3 +290,61 @@ def test_shared_surface_needs_an_owner():
                         surface_owners={"c_up": "up", "c_down": "down"})
     assert check_conformity(scene).conforming
     check_disconnected(scene)
+
+
+# ------------------------------------------------------------------ nodes no cell uses
+def _global_node_count(scene) -> int:
+    im = scene.mesh.geometry.index_map()
+    return im.size_global
+
+
+def _used_nodes_global(scene) -> int:
+    """Distinct geometry nodes referenced by the cells, counted over all ranks."""
+    g = scene.mesh.geometry
+    local = np.unique(g.dofmap.array)
+    owned = local[local < g.index_map().size_local]
+    return COMM.allreduce(int(owned.size))
+
+
+def _two_boxes_and_stray_point(model):
+    model.occ.addPoint(5.0, 5.0, 5.0)            # meshed (a node), used by no element
+    _two_boxes(model)
+
+
+def test_nodes_no_cell_uses_are_dropped():
+    scene = build_scene(COMM, "stray", _two_boxes_and_stray_point, split_body="up",
+                        contact_pair=("c_up", "c_down"),
+                        surface_owners={"c_up": "up", "c_down": "down"})
+    assert _global_node_count(scene) == _used_nodes_global(scene)
+    assert np.isclose(COMM.allreduce(
+        float(np.max(np.abs(scene.mesh.geometry.x[:, 0]), initial=0.0)), op=MPI.MAX), 1.0)
+    assert check_conformity(scene).conforming
+
+
+def test_surface_group_off_the_volumes_is_refused():
+    def build(model):
+        model.occ.addRectangle(3.0, 3.0, 5.0, 1.0, 1.0)   # a meshed surface outside the boxes
+        _two_boxes(model)
+        tags, c = entity_centers(model, 2)
+        add_groups(model, 2, {"loose": (13, tags[c[:, 0] > 2.5])})
+        model.mesh.generate(3)
+
+    with pytest.raises(ValueError, match=r"surface element\(s\) of group\(s\) \['loose'\] use "
+                       "nodes that no volume element uses"):
+        build_scene(COMM, "loose", build, split_body="up", contact_pair=("c_up", "c_down"),
+                    surface_owners={"c_up": "up", "c_down": "down", "loose": "up"})
+
+
+@pytest.mark.parametrize("mesh_size, contact_size, order, cell_type", [
+    (2.5, 0.833, 1, "tetrahedron"),      # segfaulted in distribute_entity_data before the fix
+    (20.0, 2.5, 2, "tetrahedron"),
+    (12.0, 1.7, 1, "tetrahedron"),
+    (20.0, 2.5, 1, "hexahedron"),
+    (20.0, 3.0, 2, "hexahedron"),
+])
+def test_punch_builder_sweep(mesh_size, contact_size, order, cell_type):
+    scene = flat_punch(mesh_size=mesh_size, contact_size=contact_size, order=order,
+                       cell_type=cell_type)
+    assert _global_node_count(scene) == _used_nodes_global(scene)
+    assert np.isclose(measure_of(scene, "contact_punch"), 100.0, rtol=1e-10)
+    assert check_conformity(scene).conforming
