@@ -15,8 +15,12 @@ assembled once, into a matrix whose sparsity already has room for the interface 
 with the same pattern plus the interface values.
 
 Dirichlet conditions are imposed on rows and columns of ``K`` (diagonal 1); their prescribed
-values enter the residual through a lifting vector computed once, and the iterate is kept equal
-to them (``F = x - g`` on those rows), so the Newton update there is zero.
+values g enter the residual of the free rows through the lifting vector K_full[:, bc] g, and the
+residual of a constrained row is ``x - g`` (one Newton step puts the iterate on g). Values that
+change during a run — a :class:`PrescribedDisplacement` scaled by the load factor, or a user's
+own ``DirichletBC`` whose value was changed followed by :meth:`ContactProblem.update_dirichlet`
+— recompute the lifting (one vector assembly); a stale lifting would give a wrong residual
+without any error.
 """
 
 from __future__ import annotations
@@ -35,7 +39,8 @@ from petsc4py import PETSc
 from rough_contact.fem.contact import ContactInterface
 from rough_contact.validation import check_scalar
 
-__all__ = ["Material", "SurfaceLoad", "ContactProblem", "rigid_body_modes"]
+__all__ = ["Material", "SurfaceLoad", "PrescribedDisplacement", "ContactProblem",
+           "rigid_body_modes"]
 
 
 @dataclass(frozen=True)
@@ -92,6 +97,40 @@ class SurfaceLoad:
                              f"be 3 numbers, got shape {np.shape(vec)}")
         for i, value in enumerate(vec):
             check_scalar(f"SurfaceLoad(tag={self.tag}).{name}[{i}]", value, unit=unit)
+
+
+@dataclass(frozen=True)
+class PrescribedDisplacement:
+    """A displacement prescribed on a tagged boundary surface, scaled by the load factor:
+    u = lam * value on the surface, for the chosen components (displacement control).
+
+    Args:
+        tag: facet tag of the surface.
+        value: (3,) uniform displacement at load factor 1 [mm] (entries of components not
+            prescribed are ignored), a callable ``x (3, n) -> (3, n)`` [mm] evaluated at the
+            DOF coordinates (a non-uniform field, e.g. a rotation), or a displacement Function
+            on the problem's space (its values on the surface are used).
+        components: the prescribed components (0, 1, 2 = x, y, z); the others stay free.
+    """
+
+    tag: int
+    value: object
+    components: Sequence[int] = (0, 1, 2)
+
+    def __post_init__(self):
+        comps = tuple(self.components)
+        if not comps or len(set(comps)) != len(comps) or any(c not in (0, 1, 2) for c in comps):
+            raise ValueError(f"PrescribedDisplacement(tag={self.tag}).components = "
+                             f"{self.components!r} is invalid: it must be distinct entries of "
+                             "0, 1, 2 (x, y, z)")
+        if not callable(self.value):     # (a dolfinx Function is callable too)
+            if np.shape(self.value) != (3,):
+                raise ValueError(f"PrescribedDisplacement(tag={self.tag}).value = "
+                                 f"{self.value!r} is invalid: it must be 3 numbers [mm] or a "
+                                 "callable x (3, n) -> (3, n)")
+            for i in comps:
+                check_scalar(f"PrescribedDisplacement(tag={self.tag}).value[{i}]",
+                             self.value[i], unit="mm")
 
 
 def rigid_body_modes(V: fem.FunctionSpace,
@@ -156,6 +195,8 @@ class ContactProblem:
         quadrature_degree: optional quadrature degree for the bulk forms.
         body_cells: local cell indices of each disconnected body (one array per body), for a
             near-nullspace built per body; empty = the six global rigid-body modes.
+        prescribed: displacements prescribed on tagged surfaces, scaled by the load factor
+            (:class:`PrescribedDisplacement`; ``facet_tags`` required).
 
     Raises:
         TypeError: ``interface`` is neither a ContactInterface nor None.
@@ -175,6 +216,7 @@ class ContactProblem:
         seating_stiffness: float = 0.0,
         quadrature_degree: Optional[int] = None,
         body_cells: Sequence[np.ndarray] = (),
+        prescribed: Sequence[PrescribedDisplacement] = (),
     ):
         if interface is not None and not isinstance(interface, ContactInterface):
             raise TypeError(f"interface must be a ContactInterface or None, got "
@@ -187,6 +229,12 @@ class ContactProblem:
         self.body_cells = [np.asarray(c, dtype=np.int32) for c in body_cells]
         self.load_factor = 0.0
         self.u = fem.Function(V, name="displacement")
+        self._prescribed = self._prescribed_bcs(list(prescribed), facet_tags)
+        self.bcs += [bc for _, bc, *_ in self._prescribed]
+        self._reaction_form = None
+        self.prescribed_tags = sorted({p.tag for p in prescribed})
+        if self._prescribed and interface is not None:
+            interface.set_dirichlet_dofs(bcs=self.bcs)
 
         if isinstance(materials, Material):
             materials = {None: materials}
@@ -211,6 +259,7 @@ class ContactProblem:
             sigma = 2.0 * mu * eps(u) + lmbda * ufl.tr(eps(u)) * ufl.Identity(3)
             a += ufl.inner(sigma, eps(v)) * (dx if tag is None else dx(tag))
         self.a = fem.form(a)
+        self._a_ufl, self._v = a, v
 
         # External load vector at lam = 1; tractions from total forces use the surface area.
         self.applied_force = np.zeros(3)
@@ -248,13 +297,10 @@ class ContactProblem:
 
         self.f = fem_petsc.assemble_vector(self.L)
         self.f.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        self.f_full = self.f.copy()          # with the constrained rows (for reactions)
         fem_petsc.set_bc(self.f, self.bcs, scale=0.0)
-        # lift = K_full[:, bc] g: the coupling of prescribed values into the free rows.
         self.lift = self.f.duplicate()
-        self.lift.set(0.0)
-        fem_petsc.apply_lifting(self.lift, [self.a], bcs=[self.bcs], scale=-1.0)
-        self.lift.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-        fem_petsc.set_bc(self.lift, self.bcs, scale=0.0)
+        self.update_dirichlet()
         self.f_norm = self.f.norm()
 
         self.seating_stiffness = check_scalar("seating_stiffness", seating_stiffness, lo=0.0,
@@ -326,8 +372,88 @@ class ContactProblem:
         return 0 if self.interface is None else self.interface.n_contact()
 
     def set_load_factor(self, lam: float) -> None:
-        """Set the load factor ``lam`` (external loads are ``lam`` times their nominal value)."""
+        """Set the load factor ``lam``: external loads and prescribed displacements are ``lam``
+        times their nominal value (the lifting is recomputed when displacements are
+        prescribed)."""
         self.load_factor = check_scalar("load factor", lam)
+        if self._prescribed:
+            for g, _, g1, *_ in self._prescribed:
+                g.x.array[:] = self.load_factor * g1
+            self.update_dirichlet()
+
+    def update_dirichlet(self) -> None:
+        """Recompute the lifting K_full[:, bc] g from the current Dirichlet values (collective).
+
+        Call it after changing the value of any DirichletBC of the problem by hand;
+        :meth:`set_load_factor` calls it for :class:`PrescribedDisplacement` channels.
+        """
+        with self.lift.localForm() as loc:
+            loc.set(0.0)
+        fem_petsc.apply_lifting(self.lift, [self.a], bcs=[self.bcs], scale=-1.0)
+        self.lift.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        fem_petsc.set_bc(self.lift, self.bcs, scale=0.0)
+
+    def _prescribed_bcs(self, prescribed, facet_tags):
+        """(g, bc, g at lam = 1, tag, component) per prescribed component; g lives on the
+        collapsed sub-space."""
+        out = []
+        if prescribed and facet_tags is None:
+            raise ValueError("prescribed displacements need facet_tags")
+        fdim = self.mesh.topology.dim - 1
+        for p in prescribed:
+            if not isinstance(p, PrescribedDisplacement):
+                raise TypeError(f"prescribed entries must be PrescribedDisplacement, got "
+                                f"{type(p).__name__}")
+            facets = facet_tags.find(p.tag)
+            n = self.comm.allreduce(int(facets.size), op=MPI.SUM)
+            if n == 0:
+                raise ValueError(f"PrescribedDisplacement(tag={p.tag}): no facet carries tag "
+                                 f"{p.tag}; tags present: "
+                                 f"{sorted(set(np.concatenate(self.comm.allgather(np.unique(facet_tags.values)))))}")
+            for c in p.components:
+                Vc, _ = self.V.sub(c).collapse()
+                dofs = fem.locate_dofs_topological((self.V.sub(c), Vc), fdim, facets)
+                g1 = fem.Function(Vc)
+                if isinstance(p.value, fem.Function):
+                    g1.interpolate(p.value.sub(c))
+                elif callable(p.value):
+                    g1.interpolate(lambda x, c=c, f=p.value: np.asarray(f(x), dtype=float)[c])
+                    if not np.all(np.isfinite(g1.x.array)):
+                        raise ValueError(f"PrescribedDisplacement(tag={p.tag}).value returned "
+                                         "non-finite displacements")
+                else:
+                    g1.x.array[:] = float(p.value[c])
+                g = fem.Function(Vc)
+                g.x.array[:] = self.load_factor * g1.x.array
+                out.append((g, fem.dirichletbc(g, dofs, self.V.sub(c)), g1.x.array.copy(), p.tag,
+                            c))
+        return out
+
+    def reaction(self, tag: int) -> np.ndarray:
+        """(3,) force [N] the constraints of the prescribed surface ``tag`` exert on the body:
+        the sum over its constrained DOFs of K_full u - lam f, per component (collective; a
+        component that is not prescribed there gives 0). In equilibrium it balances the other
+        forces on the body (applied loads, contact).
+
+        Raises:
+            ValueError: ``tag`` carries no PrescribedDisplacement.
+        """
+        if tag not in self.prescribed_tags:
+            raise ValueError(f"reaction: tag {tag} carries no PrescribedDisplacement; "
+                             f"prescribed tags: {self.prescribed_tags}")
+        if self._reaction_form is None:
+            self._reaction_form = fem.form(ufl.action(self._a_ufl, self.u))
+        r = fem_petsc.assemble_vector(self._reaction_form)
+        r.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        r.axpy(-self.load_factor, self.f_full)
+        arr = r.getArray()
+        total = np.zeros(3)
+        for _, bc, _, t, c in self._prescribed:
+            if t == tag:
+                dofs, n_owned = bc.dof_indices()
+                total[c] += float(arr[np.asarray(dofs)[:n_owned]].sum())
+        r.destroy()
+        return self.comm.allreduce(total, op=MPI.SUM)
 
     def reset_timings(self) -> None:
         for k in self.timings:
