@@ -68,8 +68,10 @@ def parse_args(argv):
                         help="asperity population of the normal law (elasto-plastic: Y, psi, ch, "
                         "omega_p/omega_c of Figs 18-19)")
     parser.add_argument("--outdir", default="results/flat_punch")
-    parser.add_argument("--dof-threshold", type=int, default=100_000,
-                        help="above this many DOFs the default solver is GAMG+GMRES, else MUMPS")
+    parser.add_argument("--dof-threshold", type=int, default=None,
+                        help="above this many DOFs the default linear solver is AMG-preconditioned "
+                        "GMRES, else MUMPS (default: the solver's measured threshold, "
+                        "docs/solver.md; -rc_linear_solver mumps|gamg|hypre picks one outright)")
     args, rest = parser.parse_known_args(argv)
     # PETSc options have one dash; a double-dash leftover is a mistyped option of this script.
     bad = [a for a in rest if a.startswith("--")]
