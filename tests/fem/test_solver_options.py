@@ -207,6 +207,17 @@ def test_command_line_picks_the_set_and_overrides_single_options():
         opts.delValue(name)
 
 
+def test_command_line_threshold():
+    opts = PETSc.Options()
+    problem = bulk_problem(10.0)
+    opts.setValue("thr_dof_threshold", problem.num_dofs - 1)
+    solver = SNESSolver(problem, prefix="thr_", dof_threshold=10**9)
+    assert solver.dof_threshold == problem.num_dofs - 1 and solver.option_set == AMG_DEFAULT
+    assert solver.report_unused_options() == []
+    solver.destroy()
+    opts.delValue("thr_dof_threshold")
+
+
 def test_bad_solver_choices():
     problem = bulk_problem(10.0)
     with pytest.raises(ValueError, match="linear solver = 'superlu' is invalid; valid values: "
