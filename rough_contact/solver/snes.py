@@ -86,8 +86,8 @@ LINEAR_SOLVERS: dict = {
               "pc_hypre_boomeramg_P_max": 4,
               "pc_hypre_boomeramg_agg_nl": 1,
               # Eisenstat-Walker linear tolerances: the solve dominates here, and loose early
-              # solves cost 2-3 more Newton iterations but halve the Krylov work (-40 % CPU on
-              # the punch); -rc_snes_ksp_ew false goes back to the fixed ratio ksp_rtol
+              # solves cost 1-2 more Newton iterations per increment but halve the Krylov work
+              # (-40 % CPU on the punch); -rc_snes_ksp_ew false: the fixed ratio ksp_rtol
               "snes_ksp_ew": True},
     # the LU factors of one Jacobian kept for 3 Newton iterations, across load steps, with
     # GMRES correcting for the change: half the CPU time of "mumps" at 88 k DOFs, same memory
