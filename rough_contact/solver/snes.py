@@ -13,7 +13,8 @@ are removed again, so two solvers never see each other's settings
   tolerance 1e-10 times the norm of the nominal load vector, at most 50 iterations;
 * a linear solver from the option sets of :data:`LINEAR_SOLVERS` ("mumps": direct LU;
   "gamg", "hypre": GMRES preconditioned by algebraic multigrid with the six rigid-body modes
-  as near-nullspace and 3 x 3 nodal blocks, linear tolerance 1e-6 of the current residual),
+  as near-nullspace and 3 x 3 nodal blocks, inexact Newton: linear tolerance 1e-6 of the
+  current residual for GAMG, Eisenstat-Walker for hypre),
   chosen by :class:`SNESSolver` from ``-rc_linear_solver``, else ``-rc_pc_type``, else the
   problem size (MUMPS up to :data:`DEFAULT_DOF_THRESHOLD` DOFs, :data:`AMG_DEFAULT` above);
   single options of the set are overridden by the command line one by one. The measurements
