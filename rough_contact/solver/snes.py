@@ -19,6 +19,8 @@ are removed again, so two solvers never see each other's settings
   problem size (MUMPS up to :data:`DEFAULT_DOF_THRESHOLD` DOFs, :data:`AMG_DEFAULT` above);
   single options of the set are overridden by the command line one by one. The measurements
   behind these choices are in ``docs/solver.md``.
+* each solve at a new load factor starts from the secant extrapolation of the last two
+  converged solves while the load keeps its direction (``predictor``, ``-rc_predictor``).
 
 Options given but never used (a mistyped ``-rc_snes_monitr``) are reported as a warning by
 :meth:`SNESSolver.report_unused_options`, which :meth:`SNESSolver.destroy` calls.
