@@ -19,8 +19,6 @@ are removed again, so two solvers never see each other's settings
   problem size (MUMPS up to :data:`DEFAULT_DOF_THRESHOLD` DOFs, :data:`AMG_DEFAULT` above);
   single options of the set are overridden by the command line one by one. The measurements
   behind these choices are in ``docs/solver.md``.
-* each solve at a new load factor starts from the secant extrapolation of the last two
-  converged solves while the load keeps its direction (``predictor``, ``-rc_predictor``).
 
 Options given but never used (a mistyped ``-rc_snes_monitr``) are reported as a warning by
 :meth:`SNESSolver.report_unused_options`, which :meth:`SNESSolver.destroy` calls.
@@ -168,13 +166,6 @@ class SNESSolver:
             overrides a name.
         defaults: extra default options (without prefix) that override the option set but
             not the command line.
-        predictor: initial iterate of a solve at a new load factor: "secant" (default:
-            extrapolated linearly in the load factor from the last two converged solves, while
-            the load keeps its direction; otherwise the current ``problem.u``) or "none"
-            (always the current ``problem.u``, i.e. the last committed state);
-            ``-<prefix>predictor`` overrides it. Only the Newton path changes, not the
-            converged answer (to the Newton tolerance); it assumes every converged solve is
-            kept (committed), as ``load_path`` does.
     """
 
     def __init__(
@@ -185,7 +176,6 @@ class SNESSolver:
         linear_solver: str = "auto",
         near_nullspace: Union[str, PETSc.NullSpace] = "global",
         defaults: Optional[Mapping[str, object]] = None,
-        predictor: str = "secant",
     ):
         if not isinstance(prefix, str) or (prefix and not prefix.endswith("_")):
             raise ValueError(f"options prefix {prefix!r} must be a string ending with '_'")
@@ -214,13 +204,6 @@ class SNESSolver:
             else:
                 linear_solver = "mumps" if n <= self.dof_threshold else AMG_DEFAULT
         self.option_set = linear_solver
-        if cmd.hasName(prefix + "predictor"):
-            predictor = cmd.getString(prefix + "predictor")
-        if predictor not in ("none", "secant"):
-            raise ValueError(f"predictor = {predictor!r} is invalid; valid values: 'none', "
-                             "'secant'")
-        self.predictor = predictor
-        self._history: list = []  # (load factor, converged iterate), the last two
         if cmd.hasName(prefix + "near_nullspace"):
             near_nullspace = cmd.getString(prefix + "near_nullspace")
         if isinstance(near_nullspace, str) and near_nullspace not in ("global", "per_body"):
@@ -300,17 +283,6 @@ class SNESSolver:
         """
         self._residuals = []
         self.problem.u.vector.copy(self.x)
-        lam = self.problem.load_factor
-        if self.predictor == "secant" and len(self._history) == 2:
-            (lam0, x0), (lam1, x1) = self._history
-            # only while the load keeps its direction: at a reversal the last increment says
-            # nothing about the next (friction sticks), and extrapolating cost failed solves
-            if (lam - lam1) * (lam1 - lam0) > 0.0:
-                # x = x1 + (lam - lam1) / (lam1 - lam0) (x1 - x0); Dirichlet values are the
-                # same in x0 and x1, so they stay exact
-                x1.copy(self.x)
-                self.x.axpy((lam - lam1) / (lam1 - lam0), x1)
-                self.x.axpy(-(lam - lam1) / (lam1 - lam0), x0)
         if self._auto_atol:
             # Round-off floor of F = K u - f: about eps |K|_inf |u|_inf. Below it Newton cannot
             # converge (seen at a total load of 1 mN on the punch, tests/fem/test_extremes.py).
@@ -324,10 +296,6 @@ class SNESSolver:
         self.problem.update_solution(self.x)
         res = list(self._residuals)
         ok = reason > 0 and all(np.isfinite(res))
-        if ok and self.predictor == "secant":
-            if len(self._history) == 2:
-                self._history.pop(0)[1].destroy()
-            self._history.append((lam, self.x.copy()))
         return SolveResult(ok, int(reason), _reason_name(reason), self.snes.getIterationNumber(),
                            res, self.snes.getLinearSolveIterations())
 
@@ -352,6 +320,3 @@ class SNESSolver:
         self.report_unused_options()
         self.snes.destroy()
         self.x.destroy()
-        for _, x in self._history:
-            x.destroy()
-        self._history = []
