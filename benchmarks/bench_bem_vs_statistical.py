@@ -152,8 +152,10 @@ def main(argv=None):
         print(f"  {surf} (BEM {i['grid'][0]}^2 px, {i['realisations']} realisations, A/A0 "
               f"{res['area'][0]:.3g}-{res['area'][1]:.3g}; scatter 1 std p/A/k "
               f"{res['scatter'][0]:.2f}/{res['scatter'][1]:.2f}/{res['scatter'][2]:.2f}; "
-              f"kT/kN x/y {res['tangential'][0]:.3f}/{res['tangential'][1]:.3f}; build "
-              f"statistical {res['time'][0]:.0f} s, BEM {res['time'][1]:.0f} s)")
+              + (f"kT/kN x/y {res['tangential'][0]:.3f}/{res['tangential'][1]:.3f}; "
+                 if np.isfinite(res['tangential']).all() else "")
+              + f"build: statistical {res['time'][0]:.0f} s, BEM {i['build_time_s']:.0f} s "
+              f"when computed, {i['cached']} of {i['realisations']} from the cache now)")
         for name, rng in res["agree"].items():
             txt = {q: "-" if r is None else f"{r[0]:.3g}-{r[1]:.3g}" for q, r in rng.items()}
             print(f"    {name:28s} k(p): {txt['k_at_p']:>13s}  A(p): {txt['a_at_p']:>13s}  "

@@ -68,6 +68,9 @@ def parse_args(argv):
                         help="asperity population of the normal law (elasto-plastic: Y, psi, ch, "
                         "omega_p/omega_c of Figs 18-19)")
     parser.add_argument("--outdir", default="results/flat_punch")
+    parser.add_argument("--validity", default="warn", choices=["warn", "error", "ignore"],
+                        help="interface points beyond the normal law's validity in a converged "
+                             "increment: warn (default), stop with an error, or only count them")
     parser.add_argument("--dof-threshold", type=int, default=None,
                         help="above this many DOFs the default linear solver is AMG-preconditioned "
                         "GMRES, else MUMPS (default: the solver's measured threshold, "
@@ -101,5 +104,5 @@ if __name__ == "__main__":
     run(mesh_size=args.mesh_size, contact_size=args.contact_size, order=args.order,
         load_half_width=args.load_half_width, steps=args.steps, unload=not args.no_unload,
         law=args.law, case=args.case, normal_law=args.normal_law, outdir=args.outdir,
-        dof_threshold=args.dof_threshold, overwrite=True)
+        dof_threshold=args.dof_threshold, overwrite=True, validity=args.validity)
 

@@ -329,7 +329,10 @@ def source_from_args(args):
         if dx is None:
             raise SystemExit("--height-map needs --dx (sampling step, in --unit)")
         z_mm = np.asarray(z, float) * scale
-        moments = moments_from_height_map(z_mm, dx * scale, dy * scale, unit="mm")
+        # moments of the map as the BEM sees it (mirrored if not periodic), by central
+        # differences: an FFT of a non-periodic map counts the edge jump as roughness
+        zp, _ = bem.check_height_map(z_mm, dx * scale, dy * scale, boundary=args.boundary)
+        moments = moments_from_height_map(zp, dx * scale, dy * scale, method="fd", unit="mm")
         return dict(kind="map", z=z_mm, dx=dx * scale, dy=dy * scale, boundary=args.boundary,
                     moments=moments), os.path.basename(args.height_map)
     if args.moments:

@@ -90,6 +90,8 @@ class InterfaceSummary:
         max_slip: largest |(s_x, s_y)| [mm].
         max_plastic_slip: largest |plastic slip| of the trial state [mm].
         dissipation: committed accumulated frictional dissipation int D dA [N mm].
+        n_beyond_validity: points where the law reports evaluation outside its model's range
+            (``LawResult.beyond_validity``; 0 for a law without such a limit).
     """
 
     n_points: int
@@ -103,6 +105,7 @@ class InterfaceSummary:
     max_slip: float
     max_plastic_slip: float
     dissipation: float
+    n_beyond_validity: int = 0
 
 
 @dataclass(frozen=True)
@@ -197,7 +200,15 @@ class ContactInterface:
         rigid_plane: for ``second_tag=None``: (point (3,), unit normal (3,) pointing towards the
             first body) [mm]; None = a plane tangent to the first surface at every point.
         grain_direction: (3,) global direction projected on the facet to give the local x axis.
-        quadrature_degree: degree (integer >= 0) of the facet quadrature rule.
+        quadrature_degree: degree (integer >= 0) of the facet quadrature rule (Gauss).
+        quadrature: ``"gauss"`` (default: Gauss points of ``quadrature_degree``) or
+            ``"vertex"``: the facet's vertices with equal weights (nodal, "lumped" integration;
+            P1/Q1 spaces only). With the vertex rule the law is evaluated once per surface node
+            (the facets sharing a node see the same jump) and every node carries one
+            constraint; Gauss rules put 3 (P1, degree 2) or more points per facet, i.e. about
+            6 constraints per node of a triangulated surface, which a stiff penalty over-
+            constrains: pressures and stick/slip then depend on the penalty and the rule
+            (docs/solver.md, the Coulomb punch). ``quadrature_degree`` is ignored.
         bcs: Dirichlet conditions whose DOFs the interface must not touch (also
             ``set_dirichlet_dofs``).
         match_tolerance: vertex matching tolerance relative to the facet size [-], > 0.
@@ -224,6 +235,7 @@ class ContactInterface:
         rigid_plane: Optional[RigidPlane] = None,
         grain_direction: Sequence[float] = (1.0, 0.0, 0.0),
         quadrature_degree: int = 2,
+        quadrature: str = "gauss",
         bcs: Sequence[dolfinx.fem.DirichletBCMetaClass] = (),
         match_tolerance: float = 1e-6,
     ):
@@ -231,10 +243,11 @@ class ContactInterface:
         self.V = V
         self.law = law
         grain, degree = _check_arguments(V, law, first_tag, second_tag, rigid_plane,
-                                         quadrature_degree, grain_direction, match_tolerance)
+                                         quadrature_degree, grain_direction, match_tolerance,
+                                         quadrature)
         self.first_tag, self.second_tag = first_tag, second_tag
         n_owned_facets = _facet_connectivity(V.mesh)
-        rule = _FacetRule.create(V.mesh, degree)
+        rule = _FacetRule.create(V.mesh, degree, vertex=quadrature == "vertex")
         geo1 = _FacetGeometry(V, _owned_tagged_facets(facet_tags, first_tag, n_owned_facets,
                                                       self.comm))
         self._facets1 = geo1.facets
@@ -676,7 +689,8 @@ class ContactInterface:
         sums = np.concatenate([force, [
             float(np.dot(res.area_fraction, w)), float(w.sum()), float(w[res.contact].sum()),
             float(w[res.slipping].sum()), float(np.dot(self.history.dissipated, w)),
-            float(res.contact.sum()), float(res.slipping.sum())]])
+            float(res.contact.sum()), float(res.slipping.sum()),
+            0.0 if res.beyond_validity is None else float(res.beyond_validity.sum())]])
         sums = self.comm.allreduce(sums, op=MPI.SUM)
         slip = np.linalg.norm(self._last_jump[:, 1:], axis=1)
         plastic = np.linalg.norm(self.history.trial.plastic_slip, axis=1)
@@ -687,7 +701,7 @@ class ContactInterface:
             contact_force=sums[:3], real_area=float(sums[3]), nominal_area=float(sums[4]),
             contact_area=float(sums[5]), slipping_area=float(sums[6]),
             max_slip=float(maxima[0]), max_plastic_slip=float(maxima[1]),
-            dissipation=float(sums[7]))
+            dissipation=float(sums[7]), n_beyond_validity=int(sums[10]))
 
     def slip_stats(self) -> InterfaceSummary:
         """Same as :meth:`summary` (the name older callers use)."""
@@ -730,7 +744,8 @@ class ContactInterface:
 
 
 def _check_arguments(V, law, first_tag, second_tag, rigid_plane, quadrature_degree,
-                     grain_direction, match_tolerance) -> tuple[np.ndarray, int]:
+                     grain_direction, match_tolerance, quadrature="gauss"
+                     ) -> tuple[np.ndarray, int]:
     """Validate ContactInterface's arguments; return the grain direction (3,) and the degree."""
     missing = [m for m in ("initial_state", "evaluate") if not callable(getattr(law, m, None))]
     if missing or not isinstance(law, InterfaceLawProtocol):
@@ -763,6 +778,11 @@ def _check_arguments(V, law, first_tag, second_tag, rigid_plane, quadrature_degr
         raise ValueError(f"quadrature_degree = {quadrature_degree!r} is invalid: it must be an "
                          "integer >= 0")
     check_scalar("match_tolerance", match_tolerance, lo=0.0)
+    if quadrature not in ("gauss", "vertex"):
+        raise ValueError(f"quadrature = {quadrature!r} is invalid: it must be 'gauss' or 'vertex'")
+    if quadrature == "vertex" and element.degree != 1:
+        raise ValueError(f"quadrature = 'vertex' needs a degree-1 space (P1/Q1), got degree "
+                         f"{element.degree}: use a Gauss rule for P2/Q2")
     grain = np.asarray(grain_direction, dtype=float)
     if grain.shape != (3,) or not np.all(np.isfinite(grain)) or np.linalg.norm(grain) == 0:
         raise ValueError(f"grain_direction = {grain_direction!r} must be a nonzero 3-vector")
@@ -811,11 +831,19 @@ class _FacetRule:
     normals: np.ndarray
 
     @classmethod
-    def create(cls, msh, degree: int) -> _FacetRule:
+    def create(cls, msh, degree: int, vertex: bool = False) -> _FacetRule:
+        """Gauss rule of ``degree`` on the reference facet, or (``vertex``) its vertices with
+        equal weights (exact for linear functions on triangles, bilinear ones on
+        quadrilaterals: the P1/Q1 facet fields)."""
         cell = _basix_cell(msh)
         facet_cell = _CELLS[msh.topology.cell_type][1]
         ref_facets = np.array(basix.topology(cell)[2])  # (n_lf, nv)
-        xi, w_ref = basix.make_quadrature(facet_cell, degree)
+        if vertex:
+            xi = np.asarray(basix.geometry(facet_cell), dtype=float)
+            area = 0.5 if facet_cell == basix.CellType.triangle else 1.0
+            w_ref = np.full(len(xi), area / len(xi))
+        else:
+            xi, w_ref = basix.make_quadrature(facet_cell, degree)
         lam = _vertex_weights(facet_cell, xi)  # (nq, nv)
         fv_ref = basix.geometry(cell)[ref_facets]  # (n_lf, nv, 3)
         X_lf = np.einsum("qi,fid->fqd", lam, fv_ref)  # (n_lf, nq, 3) points per local facet

@@ -66,7 +66,7 @@ dissipation increments.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Protocol, TypeVar, runtime_checkable
+from typing import Optional, Protocol, TypeVar, runtime_checkable
 
 import numpy as np
 
@@ -119,6 +119,10 @@ class LawResult:
         area_fraction: (n,) float real-area fraction A/A0 in [0, 1] [-].
         contact: (n,) bool, p > 0 (the point carries load).
         slipping: (n,) bool, the friction limit is active.
+        beyond_validity: (n,) bool, True where the law is evaluated outside the range its model
+            is valid for (e.g. a statistical normal law below its lowest tabulated separation,
+            where a stiff continuation stands in for the model); ``None`` for a law without
+            such a limit. The load stepping reports these points per increment.
     """
 
     traction: np.ndarray
@@ -128,6 +132,7 @@ class LawResult:
     area_fraction: np.ndarray
     contact: np.ndarray
     slipping: np.ndarray
+    beyond_validity: Optional[np.ndarray] = None
 
     @property
     def pressure(self) -> np.ndarray:
@@ -145,6 +150,8 @@ class LawResult:
                   ("dissipation", (n,), np.floating), ("area_fraction", (n,), np.floating),
                   ("contact", (n,), np.bool_), ("slipping", (n,), np.bool_))
         kind_names = {np.floating: "a floating-point dtype", np.bool_: "bool"}
+        if self.beyond_validity is not None:
+            fields += (("beyond_validity", (n,), np.bool_),)
         for name, shape, kind in fields:
             value = getattr(self, name)
             if not isinstance(value, np.ndarray):

@@ -29,7 +29,7 @@ from .friction import FrictionInput, IsotropicSlipHardening, OrthotropicSlipHard
 from .state import InterfaceState
 from .tangential import TangentialStiffness
 
-__all__ = ["InterfaceLaw", "NormalLawProtocol", "SeatableNormalLaw"]
+__all__ = ["InterfaceLaw", "NormalLawProtocol", "SeatableNormalLaw", "ValidityLimitedNormalLaw"]
 
 Friction = Union[OrthotropicSlipHardening, IsotropicSlipHardening]
 
@@ -60,6 +60,17 @@ class SeatableNormalLaw(NormalLawProtocol, Protocol):
 
     def separation_for_pressure(self, p: np.ndarray) -> np.ndarray:
         """Separation h (n,) [mm] at which the pressure is p (n,) > 0 [MPa] (inverse of p(h))."""
+        ...
+
+
+@runtime_checkable
+class ValidityLimitedNormalLaw(NormalLawProtocol, Protocol):
+    """A normal law whose model holds only above a separation (``NormalLaw``: below its lowest
+    knot h_min a stiff continuation stands in for the asperity model). ``InterfaceLaw`` reports
+    such points in ``LawResult.beyond_validity``."""
+
+    def below_validity(self, h: np.ndarray) -> np.ndarray:
+        """(n,) bool: True where the separation h (n,) [mm] is outside the model's range."""
         ...
 
 
@@ -154,11 +165,13 @@ class InterfaceLaw:
         traction[:, 0] = -p
         tangent[:, 0, 0] = k
         contact = p > 0.0
+        beyond = (np.asarray(self.normal.below_validity(h), dtype=bool)
+                  if isinstance(self.normal, ValidityLimitedNormalLaw) else None)
         slipping = np.zeros(n, dtype=bool)
         dissipation = np.zeros(n)
         if self.friction is None or not contact.any():
             return LawResult(traction, tangent, committed.copy(), dissipation, a, contact,
-                             slipping)
+                             slipping, beyond)
 
         cx, cy = self.tangential.kt_over_kn
         sp = committed.plastic_slip
@@ -191,4 +204,4 @@ class InterfaceLaw:
             state.slip_path[pts] += slip.path_increment
             dissipation[pts] = dw
             slipping[pts] = True
-        return LawResult(traction, tangent, state, dissipation, a, contact, slipping)
+        return LawResult(traction, tangent, state, dissipation, a, contact, slipping, beyond)

@@ -191,8 +191,11 @@ def build(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2, load_h
           law="rough", case="b", normal_law="elasto-plastic", steps=16, prefix="rc_",
           dof_threshold=None, quadrature_degree=None, normal=None, seating_steps=None,
           cell_type="tetrahedron", *, punch_scene=None, total_force=TOTAL_FORCE,
-          solver_defaults=None, solver_options=None):
+          solver_defaults=None, quadrature="gauss", solver_options=None):
     """Mesh, law, interface, problem and solver of the quarter punch. Collective.
+
+    ``quadrature`` is the interface rule (``"gauss"`` of ``quadrature_degree``, default 2 x
+    order, or ``"vertex"``: nodal, P1 only; see ``ContactInterface``).
 
     ``punch_scene`` reuses a :class:`PunchScene` of :func:`quarter_punch` (mesh sizes, order
     and cell type are then taken from it); ``total_force`` is the full punch's force at load
@@ -234,7 +237,8 @@ def build(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2, load_h
     first, second = scene.contact_pair
     qdeg = quadrature_degree if quadrature_degree is not None else 2 * order
     interface = ContactInterface(V, scene.facet_tags, first, second, law=interface_law,
-                                 grain_direction=(1.0, 0.0, 0.0), quadrature_degree=qdeg, bcs=bcs)
+                                 grain_direction=(1.0, 0.0, 0.0), quadrature_degree=qdeg,
+                                 quadrature=quadrature, bcs=bcs)
     materials = {scene.tag("punch"): Material(E, NU), scene.tag("foundation"): Material(E, NU)}
     loads = [SurfaceLoad(scene.tag("load"), force=[0.0, 0.0, -quarter_force])]
     problem = ContactProblem(V, materials, bcs, loads, cell_tags=scene.cell_tags,
@@ -269,49 +273,29 @@ def point_data(interface):
 
 
 def plot_slip_directions(comm, interface, path, title, n_grid=12):
-    """Quiver of the plastic slip directions at contact points (Figs 18-19). Collective."""
+    """Quiver of the plastic slip directions at contact points (Figs 18-19), about n_grid^2
+    arrows, drawn by :func:`rough_contact.plotting.plot_slip_quiver`. Collective."""
+    from rough_contact import plotting
+
     pts, fields = gather_points(comm, *point_data(interface))
     if comm.rank != 0:
         return
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    from scipy.spatial import cKDTree
-
-    # Sample a regular n_grid x n_grid set of points over the patch (the paper plots nodes).
-    a = float(np.max(pts[:, 0]))
-    g = (np.arange(n_grid) + 0.5) * a / n_grid
-    gx, gy = np.meshgrid(g, g)
-    _, idx = cKDTree(pts[:, :2]).query(np.column_stack([gx.ravel(), gy.ravel()]))
-    idx = np.unique(idx)
-    sp = fields["plastic_slip_mm"][idx]
-    mag = np.linalg.norm(sp, axis=1)
-    unit = np.where(mag[:, None] > 0, sp / np.maximum(mag, 1e-300)[:, None], 0.0)
-    fig, ax = plt.subplots(figsize=(6, 5.4))
-    q = ax.quiver(pts[idx, 0], pts[idx, 1], unit[:, 0], unit[:, 1], mag * 1e3, cmap="viridis",
-                  pivot="tail", scale=n_grid * 1.3, scale_units="width")
-    fig.colorbar(q, ax=ax, label="|plastic slip| [um]")
-    ax.set_xlim(0, a * 1.05)
-    ax.set_ylim(0, a * 1.05)
-    ax.set_aspect("equal")
-    ax.set_xlabel("x (grain direction) [mm]")
-    ax.set_ylabel("y [mm]")
-    ax.set_title(title + "\n(plastic part of u_foundation - u_punch, local x/y turned to global)",
-                 fontsize=9)
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
+    plotting.plot_slip_quiver(
+        pts[:, :2], fields["plastic_slip_mm"], max_arrows=n_grid * n_grid, scale=1e3,
+        label="|plastic slip| [um]", axes="xy", path=path, figsize=(6.0, 5.4), dpi=130,
+        title=title + "\n(plastic part of u_foundation - u_punch; x = grain)")
 
 
 # ## The run
 def run(mesh_size=20.0, contact_size=2.0, order=2, load_half_width=2.5, steps=16,
          unload=True, law="rough", case="b", normal_law="elasto-plastic", outdir="results/flat_punch",
          prefix="rc_", dof_threshold=None, comm=MPI.COMM_WORLD, verbose=True, plot=True,
-         overwrite=False):
+         overwrite=False, validity="warn"):
     """Run the punch; return a dict of results (identical on every rank). Collective.
 
     ``outdir`` receives one run: earlier results there make it refuse unless ``overwrite``.
+    ``validity``: what a converged increment with interface points beyond the normal law's
+    validity does (``"warn"``, ``"error"``, ``"ignore"``; ``rough_contact.solver.loading``).
     """
     t0 = MPI.Wtime()
     m = build(comm, mesh_size, contact_size, order, load_half_width, law, case, normal_law,
@@ -332,7 +316,7 @@ def run(mesh_size=20.0, contact_size=2.0, order=2, load_half_width=2.5, steps=16
                         comm=comm)
     history = []
     peak = None
-    for inc in load_path(problem, solver, factors, verbose=verbose):
+    for inc in load_path(problem, solver, factors, verbose=verbose, validity=validity):
         # Force balance: the normal interface force on the punch equals the applied load (its
         # tangential resultant is carried by the symmetry planes of the quarter model).
         err = abs(inc.contact_force[2] + inc.applied_force[2]) / abs(inc.applied_force[2])

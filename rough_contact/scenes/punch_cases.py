@@ -132,61 +132,30 @@ def run_case(case, comm=MPI.COMM_WORLD, mesh_size=10.0, contact_size=1.0, order=
     return res
 
 
-# ## Figures (rank 0)
-def _quiver(ax, snap, title, n_grid=10):
-    """Plastic slip directions at about n_grid^2 points (the paper shows 81 / 100 nodes)."""
-    from scipy.spatial import cKDTree
-
-    x = snap["x"]
-    a = float(x.max())
-    g = (np.arange(n_grid) + 0.5) * a / n_grid
-    gx, gy = np.meshgrid(g, g)
-    idx = np.unique(cKDTree(x).query(np.column_stack([gx.ravel(), gy.ravel()]))[1])
-    sp = snap["sp"][idx]
-    mag = np.linalg.norm(sp, axis=1)
-    big = mag > 1e-3 * max(mag.max(), 1e-300)
-    unit = np.where(big[:, None], sp / np.maximum(mag, 1e-300)[:, None], 0.0)
-    q = ax.quiver(x[idx, 0], x[idx, 1], unit[:, 0], unit[:, 1], mag * 1e6, cmap="viridis",
-                  pivot="tail", scale=n_grid * 1.4, scale_units="width")
-    ax.plot(x[idx[~big], 0], x[idx[~big], 1], "k.", ms=3)
-    ax.set_xlim(0, a * 1.08)
-    ax.set_ylim(0, a * 1.08)
-    ax.set_aspect("equal")
-    ax.set_xlabel("x (grain) [mm]")
-    ax.set_ylabel("y [mm]")
-    ax.set_title(title, fontsize=9)
-    return q
-
-
+# ## Figures (rank 0), drawn with rough_contact.plotting
 def plot_case(res, path):
     """Three panels: plastic slip directions at peak, after unloading; stick/slip at peak."""
-    import matplotlib
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from rough_contact import plotting
 
-    fig, axs = plt.subplots(1, 3, figsize=(15, 4.8))
+    fig = Figure(figsize=(15, 4.8))
+    FigureCanvasAgg(fig)
+    axs = fig.subplots(1, 3)
     for ax, key, when in ((axs[0], "peak", "at 1000 N"), (axs[1], "end", "after unloading")):
-        q = _quiver(ax, res[key], f"case ({res['case']}): plastic slip directions {when}")
-        fig.colorbar(q, ax=ax, label="|plastic slip| [nm]", shrink=0.85)
+        snap = res[key]
+        plotting.plot_slip_quiver(snap["x"], snap["sp"], max_arrows=100, scale=1e6,
+                                  label="|plastic slip| [nm]", ax=ax,
+                                  title=f"case ({res['case']}): plastic slip directions {when}")
     pk = res["peak"]
-    x = pk["x"]
-    ax = axs[2]
-    ax.scatter(x[~pk["slipping"], 0], x[~pk["slipping"], 1], s=3, c="tab:blue", label="stick")
-    ax.scatter(x[pk["slipping"], 0], x[pk["slipping"], 1], s=3, c="tab:red", label="slip")
-    ax.set_aspect("equal")
-    ax.set_xlim(0, x.max() * 1.08)
-    ax.set_ylim(0, x.max() * 1.08)
-    ax.set_xlabel("x (grain) [mm]")
-    ax.set_ylabel("y [mm]")
-    ax.legend(loc="upper right", fontsize=8, markerscale=3, framealpha=0.9)
-    ax.set_title(f"case ({res['case']}): stick/slip at 1000 N "
-                 f"(slip on {100 * res['slip_area_fraction_peak']:.0f} % of the patch)", fontsize=9)
+    status = np.where(pk["p"] > 0, 1 + pk["slipping"].astype(int), 0)
+    plotting.plot_status_map(pk["x"], None, status, weights=pk["w"], ax=axs[2], point_size=40,
+                             title=f"case ({res['case']}): stick/slip at 1000 N")
     fig.suptitle("Quarter punch, patch [0,10]^2 mm (centre at the origin); arrows: direction of "
                  "u^p_T (foundation - punch), colour: magnitude", fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
-    plt.close(fig)
 
 
 def plot_unloading(results, path):

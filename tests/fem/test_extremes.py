@@ -280,7 +280,7 @@ class Scene:
         bound, sp_old = 0.0, 0.0
         try:
             for inc in load_path(problem, solver, FACTORS, min_increment=MIN_INCREMENT,
-                                 verbose=False):
+                                 verbose=False, validity="ignore"):   # counted below
                 err = abs(inc.contact_force[2] + inc.applied_force[2]) / abs(inc.applied_force[2])
                 writer.write(inc, extra={"force_error_rel": err})
                 out.increments.append(inc)
@@ -297,8 +297,9 @@ class Scene:
                                                   op=MPI.MAX))
                 # points below the model's validity (A/A0 beyond the table: stiff continuation)
                 n_below = law.normal.count_below_validity(law.h0 + pf.gap)
-                out.max_below_validity = max(out.max_below_validity,
-                                             comm.allreduce(n_below, op=MPI.SUM))
+                n_below = comm.allreduce(n_below, op=MPI.SUM)
+                assert inc.n_beyond_validity == n_below     # the load stepping's own count
+                out.max_below_validity = max(out.max_below_validity, n_below)
                 out.n_points = inc.n_points
                 sp_new = interface.slip_stats().max_plastic_slip
                 bound += case.mu * abs(inc.contact_force[2]) * (sp_new + sp_old)

@@ -221,3 +221,30 @@ def test_friction_evaluate_bad_input():
         fr.evaluate(pts, None, np.zeros((3, 2, 3), dtype=np.float32))
     with pytest.raises(ValueError, match="FrictionInput"):
         fr.evaluate({"pressure": np.zeros(3)})
+
+
+# ------------------------------------------------------------------ model validity
+def test_beyond_validity_is_optional_and_checked():
+    r = good_result(4)
+    assert r.beyond_validity is None
+    dataclasses.replace(r, beyond_validity=np.zeros(4, bool)).check(4)
+    with pytest.raises(LawContractError, match=r"LawResult\.beyond_validity has shape \(3,\)"):
+        dataclasses.replace(r, beyond_validity=np.zeros(3, bool)).check(4)
+    with pytest.raises(LawContractError, match=r"LawResult\.beyond_validity has dtype float64"):
+        dataclasses.replace(r, beyond_validity=np.zeros(4)).check(4)
+
+
+@pytest.mark.parametrize("name", ["rough_ortho", "rough_frictionless"])
+def test_rough_law_reports_points_below_the_table(gw_normal, name):
+    """beyond_validity is exactly the normal law's h < h_min (its lowest knot) at h0 + g."""
+    law = built_in_laws(gw_normal)[name]
+    h_min = gw_normal.knots[0]
+    g = np.array([h_min - 1e-4, h_min - 1e-9, h_min + 1e-9, h_min + 1e-3, 1.0]) - law.h0
+    jump = np.column_stack([g, np.zeros((5, 2))])
+    r = law.evaluate(jump, law.initial_state(5))
+    np.testing.assert_array_equal(r.beyond_validity, [True, True, False, False, False])
+
+
+def test_penalty_laws_have_no_validity_limit():
+    for law in (LinearPenalty(1e4, 2e3, unilateral=True), SoftplusPenalty(1e4, 1e-3, 5e3, 0.3)):
+        assert law.evaluate(np.full((2, 3), -1.0), law.initial_state(2)).beyond_validity is None

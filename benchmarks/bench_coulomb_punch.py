@@ -1,0 +1,114 @@
+"""GetFEM's flat-punch benchmark with the Coulomb penalty law: Newton iterations, CPU, dissipation.
+
+Quarter model of a 20 x 20 x 10 mm punch on a 100 x 100 x 50 mm foundation (E = 200 GPa,
+nu = 0.25 both), foundation bottom clamped, symmetry planes, uniform pressure 2.5 MPa on the
+punch top (1000 N on the full punch), 16 loading increments and 16 unloading ones down to 1/16
+of the load (a punch held only by a penalty contact has no equilibrium at zero load),
+isotropic Coulomb friction (``SoftplusPenalty``). Prints per run: DOFs, interface points,
+Newton iterations (all attempts, including failed ones), cutbacks, the largest count in one
+increment, CPU time and the dissipation at the peak and at the end.
+
+    OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bench_coulomb_punch.py \\
+        [--levels 1 2 3] [--mu 0.2 0.5] [--k 1e7] [--predictor none secant] [--csv FILE]
+
+Level 1: P1, contact size 1.25 mm (~4.7 k DOFs); level 2: 0.6 mm (~28 k); level 3: 0.4 mm.
+Units: mm, N, MPa.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import sys
+import time
+
+import petsc4py
+
+petsc4py.init(sys.argv)   # -rc_* options reach PETSc (before dolfinx is imported)
+
+import numpy as np  # noqa: E402
+from mpi4py import MPI  # noqa: E402
+from petsc4py import PETSc  # noqa: E402
+
+from rough_contact.interface.penalty import SoftplusPenalty
+from rough_contact.scenes import flat_punch
+from rough_contact.solver.loading import load_path, load_unload_factors
+
+LEVELS = {1: (10.0, 0.7), 2: (5.0, 0.3), 3: (3.3, 0.2)}   # (mesh size, contact size) [mm]
+N_LOAD = 16
+
+
+def run(level: int, mu: float, k: float, width: float, predictor: str, quadrature="gauss",
+        comm=MPI.COMM_WORLD, verbose=False) -> dict:
+    mesh_size, contact_size = LEVELS[level]
+    law = SoftplusPenalty(k_normal=k, width=width, k_tangential=k, friction=mu)
+    m = flat_punch.build(comm, mesh_size=mesh_size, contact_size=contact_size, order=1,
+                         load_half_width=10.0, law=law, steps=N_LOAD, quadrature=quadrature)
+    its = {"newton": 0, "linear": 0, "solves": 0}
+    solve = m.solver.solve
+
+    def counting_solve():
+        res = solve()
+        its["newton"] += res.iterations
+        its["linear"] += res.linear_iterations if hasattr(res, "linear_iterations") else 0
+        its["solves"] += 1
+        return res
+
+    m.solver.solve = counting_solve
+    factors = load_unload_factors(N_LOAD, N_LOAD - 1, final_factor=1.0 / N_LOAD)
+    t0 = time.process_time()
+    incs = []
+    kwargs = {"predictor": predictor}
+    for inc in load_path(m.problem, m.solver, factors, verbose=verbose, **kwargs):
+        incs.append(inc)
+    cpu = comm.allreduce(time.process_time() - t0, op=MPI.SUM)
+    peak = next(i for i in incs if i.load_factor == 1.0)
+    out = dict(level=level, dofs=m.problem.num_dofs, points=m.interface.n_points_global, mu=mu,
+               k=k, predictor=predictor, quadrature=quadrature, newton=its["newton"], solves=its["solves"],
+               cutbacks=sum(i.cutbacks for i in incs),
+               max_its=max(i.iterations for i in incs), cpu=cpu,
+               D_peak=peak.dissipation, D_end=incs[-1].dissipation,
+               slip_peak=peak.n_slipping / max(peak.n_points, 1))
+    m.solver.destroy()
+    return out
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--levels", type=int, nargs="+", default=[1], choices=sorted(LEVELS))
+    ap.add_argument("--mu", type=float, nargs="+", default=[0.2])
+    ap.add_argument("--k", type=float, nargs="+", default=[1e7], help="penalty k_N = k_T [MPa/mm]")
+    ap.add_argument("--width", type=float, default=None,
+                    help="softplus width [mm] (default 1e-2 * 2.5 MPa / k: p(0) ~ 0.7 %% of p)")
+    ap.add_argument("--predictor", nargs="+", default=["secant"], choices=["secant", "none"])
+    ap.add_argument("--quadrature", nargs="+", default=["gauss"], choices=["gauss", "vertex"])
+    ap.add_argument("--csv", default=None)
+    ap.add_argument("--verbose", action="store_true")
+    args, _petsc = ap.parse_known_args(argv)   # the rest goes to PETSc
+    rows = []
+    head = (f"{'level':>5} {'DOFs':>7} {'points':>6} {'mu':>4} {'k':>7} {'predictor':>9} "
+            f"{'Newton':>6} {'solves':>6} {'cutb':>4} {'max/inc':>7} {'CPU s':>7} "
+            f"{'D peak':>10} {'D end':>10} {'slip':>5}")
+    PETSc.Sys.Print(head)
+    for level in args.levels:
+        for mu in args.mu:
+            for k in args.k:
+                for pred, quad in [(a, b) for a in args.predictor for b in args.quadrature]:
+                    w = args.width if args.width is not None else 1e-2 * 2.5 / k
+                    r = run(level, mu, k, w, pred, quad, verbose=args.verbose)
+                    rows.append(r)
+                    PETSc.Sys.Print(
+                        f"{r['level']:5d} {r['dofs']:7d} {r['points']:6d} {mu:4.2f} {k:7.1e} "
+                        f"{pred + '/' + quad[0]:>9} {r['newton']:6d} {r['solves']:6d} {r['cutbacks']:4d} "
+                        f"{r['max_its']:7d} {r['cpu']:7.1f} {r['D_peak']:10.4e} "
+                        f"{r['D_end']:10.4e} {r['slip_peak']:5.2f}")
+    if args.csv and MPI.COMM_WORLD.rank == 0:
+        with open(args.csv, "w", newline="") as f:
+            w = csv.DictWriter(f, fieldnames=list(rows[0]))
+            w.writeheader()
+            w.writerows(rows)
+    return rows
+
+
+if __name__ == "__main__":
+    main()
