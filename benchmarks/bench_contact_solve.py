@@ -11,8 +11,9 @@ Run serial and on 2 ranks:
     python3 benchmarks/bench_contact_solve.py --sizes small medium
     mpirun -n 2 python3 benchmarks/bench_contact_solve.py --sizes small medium large
 
-Sizes (quarter punch, tetrahedra; the default linear solver is MUMPS LU below 100k DOFs and
-GAMG + GMRES above it; change with -rc_ksp_type/-rc_pc_type and --dof-threshold):
+Sizes (quarter punch, tetrahedra; the linear solver is the SNESSolver default, MUMPS LU up to
+30 k DOFs and hypre-preconditioned GMRES above; change with -rc_linear_solver, --dof-threshold
+and single -rc_ options, docs/solver.md; benchmarks/bench_solver.py compares the sets):
     small   P1, mesh 10 mm, contact 1.0 mm     (~3k DOFs)
     medium  P2, mesh 5 mm,  contact 0.5 mm     (~88k DOFs)
     large   P2, mesh 3.5 mm, contact 0.35 mm   (>200k DOFs)
@@ -35,7 +36,7 @@ def parse_args(argv):
     parser.add_argument("--steps", type=int, default=2,
                         help="load increments to 1000 N (the last one slips at the edge)")
     parser.add_argument("--case", default="b", choices=["a", "b", "c", "none"])
-    parser.add_argument("--dof-threshold", type=int, default=100_000)
+    parser.add_argument("--dof-threshold", type=int, default=None)
     return parser.parse_known_args(argv)
 
 
@@ -93,7 +94,7 @@ def bench_one(comm, mesh_size, contact_size, order, steps, case, dof_threshold, 
     return row
 
 
-def main(sizes=("small", "medium"), custom=(), steps=2, case="b", dof_threshold=100_000,
+def main(sizes=("small", "medium"), custom=(), steps=2, case="b", dof_threshold=None,
          comm=MPI.COMM_WORLD):
     PETSc.Log.begin()  # needed for the KSPSolve / PCSetUp event times
     configs = [(name, *SIZES[name]) for name in sizes]

@@ -83,8 +83,10 @@ def parse_args(argv):
     parser.add_argument("--figdir", default=None, help="also copy the figures here "
                         "(e.g. docs/figures)")
     parser.add_argument("--fig-suffix", default="", help="appended to the figure file names")
-    parser.add_argument("--dof-threshold", type=int, default=200_000,
-                        help="above this many DOFs the default solver is GAMG+CG, else MUMPS")
+    parser.add_argument("--dof-threshold", type=int, default=None,
+                        help="above this many DOFs the default linear solver is AMG-preconditioned "
+                        "GMRES, else MUMPS (default: the solver's measured threshold, "
+                        "docs/solver.md; -rc_linear_solver mumps|gamg|hypre picks one outright)")
     parser.add_argument("--no-xdmf", action="store_true", help="write no XDMF/point clouds")
     args, rest = parser.parse_known_args(argv)
     # PETSc options have one dash; a double-dash leftover is a mistyped option of this script.

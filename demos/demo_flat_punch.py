@@ -71,8 +71,10 @@ def parse_args(argv):
     parser.add_argument("--validity", default="warn", choices=["warn", "error", "ignore"],
                         help="interface points beyond the normal law's validity in a converged "
                              "increment: warn (default), stop with an error, or only count them")
-    parser.add_argument("--dof-threshold", type=int, default=100_000,
-                        help="above this many DOFs the default solver is GAMG+GMRES, else MUMPS")
+    parser.add_argument("--dof-threshold", type=int, default=None,
+                        help="above this many DOFs the default linear solver is AMG-preconditioned "
+                        "GMRES, else MUMPS (default: the solver's measured threshold, "
+                        "docs/solver.md; -rc_linear_solver mumps|gamg|hypre picks one outright)")
     args, rest = parser.parse_known_args(argv)
     # PETSc options have one dash; a double-dash leftover is a mistyped option of this script.
     bad = [a for a in rest if a.startswith("--")]

@@ -189,9 +189,9 @@ class PunchModel:
 
 def build(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2, load_half_width=2.5,
           law="rough", case="b", normal_law="elasto-plastic", steps=16, prefix="rc_",
-          dof_threshold=100_000, quadrature_degree=None, normal=None, seating_steps=None,
+          dof_threshold=None, quadrature_degree=None, normal=None, seating_steps=None,
           cell_type="tetrahedron", *, punch_scene=None, total_force=TOTAL_FORCE,
-          solver_defaults=None, quadrature="gauss"):
+          solver_defaults=None, quadrature="gauss", solver_options=None):
     """Mesh, law, interface, problem and solver of the quarter punch. Collective.
 
     ``quadrature`` is the interface rule (``"gauss"`` of ``quadrature_degree``, default 2 x
@@ -200,7 +200,9 @@ def build(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2, load_h
     ``punch_scene`` reuses a :class:`PunchScene` of :func:`quarter_punch` (mesh sizes, order
     and cell type are then taken from it); ``total_force`` is the full punch's force at load
     factor 1 [N] (the quarter carries a quarter); ``solver_defaults`` are extra SNES/KSP/PC
-    defaults (without prefix) that the command line can override.
+    defaults (without prefix) that the command line can override; ``solver_options`` are
+    extra keyword arguments of :class:`~rough_contact.solver.snes.SNESSolver` (e.g.
+    ``linear_solver="hypre"``); ``dof_threshold=None`` is the solver's measured default.
 
     ``normal`` passes a prebuilt NormalLaw (same on every rank); ``seating_steps`` (default
     ``steps``) sets the seating pressure to the nominal pressure of 1/seating_steps of the load.
@@ -244,7 +246,7 @@ def build(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2, load_h
                              seating_tag=first, seating_stiffness=1e3,
                              body_cells=[scene.cell_tags.find(scene.tag(b)) for b in scene.bodies])
     solver = SNESSolver(problem, prefix=prefix, dof_threshold=dof_threshold,
-                        defaults=solver_defaults)
+                        defaults=solver_defaults, **(solver_options or {}))
     return PunchModel(scene=scene, V=V, law=interface_law, normal=normal, interface=interface,
                       problem=problem, solver=solver, quarter_force=quarter_force)
 
@@ -287,7 +289,7 @@ def plot_slip_directions(comm, interface, path, title, n_grid=12):
 # ## The run
 def run(mesh_size=20.0, contact_size=2.0, order=2, load_half_width=2.5, steps=16,
          unload=True, law="rough", case="b", normal_law="elasto-plastic", outdir="results/flat_punch",
-         prefix="rc_", dof_threshold=100_000, comm=MPI.COMM_WORLD, verbose=True, plot=True,
+         prefix="rc_", dof_threshold=None, comm=MPI.COMM_WORLD, verbose=True, plot=True,
          overwrite=False, validity="warn"):
     """Run the punch; return a dict of results (identical on every rank). Collective.
 

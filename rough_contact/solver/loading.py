@@ -100,7 +100,7 @@ class Increment:
         step: 1-based count of converged steps.
         load_factor: load factor reached [-].
         target: the load factor of the load path this step heads for [-].
-        iterations: Newton iterations.
+        iterations: Newton iterations of the attempt that converged.
         residual: final residual norm [N].
         residuals: residual norm history of the Newton iterations [N].
         n_points: interface quadrature points (0 without interface).
@@ -111,6 +111,13 @@ class Increment:
         real_area: real contact area [mm^2] (nan if unknown).
         dissipation: cumulative frictional dissipation [N mm] (nan if unknown).
         cutbacks: halvings done before this step converged.
+        newton_total: Newton iterations spent since the previous converged step: this one's
+            plus those of every failed attempt in between (cutbacks).
+        linear_iterations: Krylov iterations of the attempt that converged (1 per Newton
+            iteration for a direct solver).
+        linear_total: Krylov iterations spent since the previous converged step, failed
+            attempts included.
+        failed_attempts: Newton solves that failed since the previous converged step.
         wall_time: seconds spent on this step (including failed attempts).
         linear_solver: KSP+PC used.
         n_beyond_validity: interface points outside the law's range of validity (see the
@@ -134,6 +141,10 @@ class Increment:
     wall_time: float = 0.0
     linear_solver: str = ""
     n_beyond_validity: int = 0
+    newton_total: int = 0
+    linear_iterations: int = 0
+    linear_total: int = 0
+    failed_attempts: int = 0
 
 
 def load_unload_factors(n_load: int, n_unload: Optional[int] = None,
@@ -166,6 +177,11 @@ def _print_increment(inc: Increment) -> None:
     f = inc.contact_force
     PETSc.Sys.Print(
         f"  step {inc.step:3d}  load {inc.load_factor:8.5f}  Newton {inc.iterations:2d}  "
+        + (f"(spent {inc.newton_total}, {inc.failed_attempts} failed) "
+           if inc.failed_attempts else "")
+        + f"lin {inc.linear_iterations}"
+        + (f" (spent {inc.linear_total})" if inc.failed_attempts else "")
+        + "  "
         f"|F| {inc.residual:9.3e}  active {inc.n_active:6d}/{inc.n_points:<6d} "
         f"slip {inc.n_slipping:6d}  contact force ({f[0]: .4g}, {f[1]: .4g}, {f[2]: .4g}) N"
         + (f"  cutbacks {inc.cutbacks}" if inc.cutbacks else "")
@@ -227,6 +243,7 @@ def load_path(problem: ContactProblem, solver: SNESSolver, factors: Iterable[flo
     lam_committed = problem.load_factor
     u_previous, lam_previous = None, None     # the converged state before u_committed
     step = 0
+    spent = [0, 0, 0]  # Newton its, linear its, failed attempts since the last converged step
     for i, target in enumerate(factors):
         target = check_scalar(f"load factor {i} of the load path", target)
         delta = target - lam_committed
@@ -248,6 +265,8 @@ def load_path(problem: ContactProblem, solver: SNESSolver, factors: Iterable[flo
                 problem.u.vector.axpy(-r, u_previous)
                 problem.u.x.scatter_forward()
             ok, result, failure = _attempt(solver, comm)
+            spent[0] += result.iterations
+            spent[1] += result.linear_iterations
             if ok:
                 # Re-evaluate at the converged iterate so the trial history matches it.
                 problem.F(None, solver.x, problem.b)
@@ -266,7 +285,10 @@ def load_path(problem: ContactProblem, solver: SNESSolver, factors: Iterable[flo
                     residual=result.residuals[-1] if result.residuals else float("nan"),
                     residuals=list(result.residuals), applied_force=lam * problem.applied_force,
                     cutbacks=cutbacks, wall_time=time.perf_counter() - t_start,
-                    linear_solver=solver.linear_solver)
+                    linear_solver=solver.linear_solver, newton_total=spent[0],
+                    linear_iterations=result.linear_iterations, linear_total=spent[1],
+                    failed_attempts=spent[2])
+                spent = [0, 0, 0]
                 if interface is not None:
                     s = interface.summary()
                     inc.n_points, inc.n_active, inc.n_slipping = (s.n_points, s.n_contact,
@@ -284,6 +306,7 @@ def load_path(problem: ContactProblem, solver: SNESSolver, factors: Iterable[flo
                     delta *= max_growth
                 continue
             # Failure to converge: revert to the committed state and halve the increment.
+            spent[2] += 1
             u_committed.copy(problem.u.vector)
             problem.u.x.scatter_forward()
             problem.set_load_factor(lam_committed)
@@ -347,6 +370,7 @@ def _attempt(solver: SNESSolver, comm: MPI.Comm):
         # raised on every rank together by the interface (rough_contact.fem.collective)
         result, ok, failure = None, False, exc
     ok_all = comm.allreduce(bool(ok), op=MPI.LAND)
-    if result is None:
-        result = SolveResult(False, 0, "CONVERGENCE_ERROR", 0, [])
+    if result is None:  # the work done up to the exception still counts
+        result = SolveResult(False, 0, "CONVERGENCE_ERROR", solver.snes.getIterationNumber(),
+                             [], solver.snes.getLinearSolveIterations())
     return ok_all, result, failure

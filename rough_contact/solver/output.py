@@ -88,6 +88,8 @@ _CSV_COLUMNS = [
     ("n_active", "n_active"), ("n_slipping", "n_slipping"), ("real_area_mm2", "real_area"),
     ("dissipation_Nmm", "dissipation"), ("cutbacks", "cutbacks"), ("wall_time_s", "wall_time"),
     ("n_beyond_validity", "n_beyond_validity"),
+    ("newton_its_spent", "newton_total"), ("linear_its", "linear_iterations"),
+    ("linear_its_spent", "linear_total"), ("failed_attempts", "failed_attempts"),
 ]
 
 

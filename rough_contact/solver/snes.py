@@ -11,9 +11,14 @@ are removed again, so two solvers never see each other's settings
 
 * Newton with a line search (``newtonls`` + ``bt``), relative tolerance 1e-9, absolute
   tolerance 1e-10 times the norm of the nominal load vector, at most 50 iterations;
-* a direct LU factorisation with MUMPS below ``dof_threshold`` global DOFs;
-* above it, GMRES (the frictional tangent is not symmetric) preconditioned by GAMG with the
-  rigid-body near-nullspace of every body.
+* a linear solver from the option sets of :data:`LINEAR_SOLVERS` ("mumps": direct LU;
+  "gamg", "hypre": GMRES preconditioned by algebraic multigrid with the six rigid-body modes
+  as near-nullspace and 3 x 3 nodal blocks, inexact Newton: linear tolerance 1e-6 of the
+  current residual for GAMG, Eisenstat-Walker for hypre),
+  chosen by :class:`SNESSolver` from ``-rc_linear_solver``, else ``-rc_pc_type``, else the
+  problem size (MUMPS up to :data:`DEFAULT_DOF_THRESHOLD` DOFs, :data:`AMG_DEFAULT` above);
+  single options of the set are overridden by the command line one by one. The measurements
+  behind these choices are in ``docs/solver.md``.
 
 Options given but never used (a mistyped ``-rc_snes_monitr``) are reported as a warning by
 :meth:`SNESSolver.report_unused_options`, which :meth:`SNESSolver.destroy` calls.
@@ -29,7 +34,7 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass, field
-from typing import Mapping, Optional
+from typing import Mapping, Optional, Union
 
 import numpy as np
 from petsc4py import PETSc
@@ -38,7 +43,64 @@ from rough_contact.fem.problem import ContactProblem, rigid_body_modes
 from rough_contact.solver.options import default_options, set_default_options, unused_options
 from rough_contact.validation import check_scalar
 
-__all__ = ["SolveResult", "SNESSolver", "UnusedOptionsWarning", "set_default_options"]
+__all__ = ["SolveResult", "SNESSolver", "UnusedOptionsWarning", "set_default_options",
+           "LINEAR_SOLVERS", "AMG_DEFAULT", "DEFAULT_DOF_THRESHOLD"]
+
+
+# The option sets (PETSc option names without prefix) and the size rule; the figures behind
+# the choices are in docs/solver.md (benchmarks/bench_solver.py).
+_KRYLOV = {
+    # The frictional tangent is not symmetric: GMRES, not CG. The linear tolerance is a fixed
+    # ratio (inexact Newton): 1e-6 of the current residual costs no extra Newton iteration
+    # on the punch and 35-40 % fewer Krylov iterations than 1e-10 (docs/solver.md).
+    "ksp_type": "gmres",
+    "ksp_gmres_restart": 100,
+    "ksp_rtol": 1e-6,
+    "ksp_max_it": 1000,
+    "ksp_norm_type": "unpreconditioned",
+    "ksp_pc_side": "right",
+}
+LINEAR_SOLVERS: dict = {
+    # direct LU; this MUMPS build has PORD ordering only
+    "mumps": {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"},
+    # smoothed-aggregation AMG with the rigid-body near-nullspace, Chebyshev/Jacobi smoothing
+    "gamg": {**_KRYLOV,
+             "pc_type": "gamg",
+             "pc_gamg_type": "agg",
+             "pc_gamg_agg_nsmooths": 1,
+             "pc_gamg_threshold": 0.01,
+             "pc_gamg_square_graph": 1,
+             "pc_gamg_coarse_eq_limit": 1000,
+             "mg_levels_ksp_type": "chebyshev",
+             "mg_levels_pc_type": "jacobi",
+             "mg_levels_esteig_ksp_type": "cg"},
+    # BoomerAMG for 3D elasticity: strong threshold 0.7, HMIS coarsening with one aggressive
+    # level, ext+i interpolation truncated to 4 entries. Nodal coarsening and rigid-body
+    # vector interpolation (-rc_pc_hypre_boomeramg_nodal_coarsen 6
+    # -rc_pc_hypre_boomeramg_vec_interp_variant 2) cost more than they save here.
+    "hypre": {**_KRYLOV,
+              "pc_type": "hypre",
+              "pc_hypre_type": "boomeramg",
+              "pc_hypre_boomeramg_strong_threshold": 0.7,
+              "pc_hypre_boomeramg_coarsen_type": "HMIS",
+              "pc_hypre_boomeramg_interp_type": "ext+i",
+              "pc_hypre_boomeramg_P_max": 4,
+              "pc_hypre_boomeramg_agg_nl": 1,
+              # Eisenstat-Walker linear tolerances: the solve dominates here, and loose early
+              # solves cost 1-2 more Newton iterations per increment but halve the Krylov work
+              # (-40 % CPU on the punch); -rc_snes_ksp_ew false: the fixed ratio ksp_rtol
+              "snes_ksp_ew": True},
+    # the LU factors of one Jacobian kept for 3 Newton iterations, across load steps, with
+    # GMRES correcting for the change: half the CPU time of "mumps" at 88 k DOFs, same memory
+    "mumps_lagged": {**_KRYLOV, "pc_type": "lu", "pc_factor_mat_solver_type": "mumps",
+                     "snes_lag_preconditioner": 3, "snes_lag_preconditioner_persists": True},
+    # GMRES with the tolerances above; the preconditioner is whatever -rc_pc_type says
+    "krylov": dict(_KRYLOV),
+}
+#: The AMG set the size rule picks above the threshold (measured, docs/solver.md).
+AMG_DEFAULT = "hypre"
+#: Global DOF count up to which the size rule keeps MUMPS (measured, docs/solver.md).
+DEFAULT_DOF_THRESHOLD = 30_000
 
 
 class UnusedOptionsWarning(UserWarning):
@@ -76,14 +138,33 @@ def _reason_name(reason: int) -> str:
 class SNESSolver:
     """Newton solver on a :class:`~rough_contact.fem.problem.ContactProblem`.
 
+    The linear solver is one of the option sets of :data:`LINEAR_SOLVERS`, chosen as follows
+    (``docs/solver.md``):
+
+    1. ``-<prefix>linear_solver NAME`` on the command line, else the ``linear_solver``
+       argument, if it is not ``"auto"``;
+    2. else ``-<prefix>pc_type`` on the command line: ``lu``/``cholesky`` pick ``"mumps"``,
+       ``gamg`` and ``hypre`` pick their own set, anything else ``"krylov"`` (GMRES with the
+       set's tolerances and no preconditioner options);
+    3. else by size: ``"mumps"`` up to ``dof_threshold`` global DOFs, :data:`AMG_DEFAULT`
+       above.
+
+    Single options of the set are then overridden one by one by the ``defaults`` argument and,
+    above it, by the command line (``-rc_ksp_rtol 1e-8`` changes the linear tolerance only).
+
     Args:
         problem: the problem (its ``F``, ``J``, ``u``, ``A``, ``b``, ``K``, ``f_norm``).
         prefix: PETSc options prefix of the SNES (and its KSP/PC), ending with "_".
-        dof_threshold: global DOF count (>= 0) above which the default linear solver is
-            GMRES+GAMG instead of MUMPS LU.
-        near_nullspace: PETSc near-nullspace set on the Jacobian (for GAMG); ``None`` builds the
-            rigid body modes of ``problem.V`` when the iterative default is used.
-        defaults: extra default options (without prefix) that override the built-in ones but
+        dof_threshold: global DOF count (>= 0) above which the size rule picks the AMG set;
+            ``None`` = :data:`DEFAULT_DOF_THRESHOLD` (measured); ``-<prefix>dof_threshold``
+            overrides it.
+        linear_solver: "auto" or a name of :data:`LINEAR_SOLVERS`.
+        near_nullspace: for the AMG sets: "global" (the six rigid-body modes of the whole
+            mesh: bodies coupled through the interface share one coarse space), "per_body"
+            (six modes per body of ``problem.body_cells``: only for bodies that can float
+            free), or a PETSc near-nullspace; ``-<prefix>near_nullspace global|per_body``
+            overrides a name.
+        defaults: extra default options (without prefix) that override the option set but
             not the command line.
     """
 
@@ -91,18 +172,43 @@ class SNESSolver:
         self,
         problem: ContactProblem,
         prefix: str = "rc_",
-        dof_threshold: int = 100_000,
-        near_nullspace: Optional[PETSc.NullSpace] = None,
+        dof_threshold: Optional[int] = None,
+        linear_solver: str = "auto",
+        near_nullspace: Union[str, PETSc.NullSpace] = "global",
         defaults: Optional[Mapping[str, object]] = None,
     ):
         if not isinstance(prefix, str) or (prefix and not prefix.endswith("_")):
             raise ValueError(f"options prefix {prefix!r} must be a string ending with '_'")
-        check_scalar("dof_threshold", dof_threshold, lo=0, lo_open=False)
         self.problem = problem
         self.prefix = prefix
         comm = problem.comm
         n = problem.num_dofs
-        direct = n <= dof_threshold
+        cmd = PETSc.Options()
+        if cmd.hasName(prefix + "dof_threshold"):
+            dof_threshold = cmd.getInt(prefix + "dof_threshold")
+        if dof_threshold is None:
+            dof_threshold = DEFAULT_DOF_THRESHOLD
+        check_scalar("dof_threshold", dof_threshold, lo=0, lo_open=False)
+        self.dof_threshold = int(dof_threshold)
+        if cmd.hasName(prefix + "linear_solver"):
+            linear_solver = cmd.getString(prefix + "linear_solver")
+        if linear_solver != "auto" and linear_solver not in LINEAR_SOLVERS:
+            raise ValueError(f"linear solver = {linear_solver!r} is invalid; valid values: "
+                             f"'auto', {', '.join(repr(k) for k in LINEAR_SOLVERS)}")
+        if linear_solver == "auto":
+            pc_user = (cmd.getString(prefix + "pc_type") if cmd.hasName(prefix + "pc_type")
+                       else None)
+            if pc_user is not None:
+                linear_solver = {"lu": "mumps", "cholesky": "mumps", "gamg": "gamg",
+                                 "hypre": "hypre"}.get(pc_user, "krylov")
+            else:
+                linear_solver = "mumps" if n <= self.dof_threshold else AMG_DEFAULT
+        self.option_set = linear_solver
+        if cmd.hasName(prefix + "near_nullspace"):
+            near_nullspace = cmd.getString(prefix + "near_nullspace")
+        if isinstance(near_nullspace, str) and near_nullspace not in ("global", "per_body"):
+            raise ValueError(f"near_nullspace = {near_nullspace!r} is invalid; valid values: "
+                             "'global', 'per_body' or a PETSc.NullSpace")
         opts = {
             "snes_type": "newtonls",
             "snes_linesearch_type": "bt",
@@ -112,34 +218,18 @@ class SNESSolver:
             "snes_max_it": 50,
             "snes_error_if_not_converged": False,
         }
-        if direct:
-            opts.update({
-                "ksp_type": "preonly",
-                "pc_type": "lu",
-                "pc_factor_mat_solver_type": "mumps",
-            })
-        else:
-            opts.update({
-                # the frictional tangent is not symmetric: GMRES, not CG
-                "ksp_type": "gmres",
-                "ksp_gmres_restart": 100,
-                "ksp_rtol": 1e-10,
-                "ksp_max_it": 1000,
-                "pc_type": "gamg",
-                "pc_gamg_type": "agg",
-                "pc_gamg_agg_nsmooths": 1,
-                "pc_gamg_threshold": 0.02,
-                "mg_levels_ksp_type": "chebyshev",
-                "mg_levels_pc_type": "jacobi",
-                "mg_levels_esteig_ksp_type": "cg",
-            })
+        opts.update(LINEAR_SOLVERS[linear_solver])
         opts.update(defaults or {})
         self.defaults = opts  # without prefix; in the database only inside _options()
         # An absolute tolerance given by the user (command line or ``defaults``) is kept as is;
         # otherwise solve() raises it to the residual's round-off floor (tiny loads).
-        self._auto_atol = not PETSc.Options().hasName(prefix + "snes_atol") and (
+        self._auto_atol = not cmd.hasName(prefix + "snes_atol") and (
             "snes_atol" not in (defaults or {}))
 
+        if problem.A.getBlockSize() != 3:
+            raise ValueError(f"Jacobian block size = {problem.A.getBlockSize()} is invalid: the "
+                             "AMG preconditioners need the 3 displacement components per node "
+                             "as one block (3)")
         self.snes = PETSc.SNES().create(comm)
         self.snes.setOptionsPrefix(prefix)
         # Never hand u.vector to SNES: the callbacks copy x into u, and line-search work
@@ -152,12 +242,16 @@ class SNESSolver:
         self._atol0 = self.snes.getTolerances()[1]
         self._k_norm_inf = problem.K.norm(PETSc.NormType.INFINITY)
         pc_type = self.snes.getKSP().getPC().getType()
-        if pc_type == "gamg" or near_nullspace is not None:
-            if near_nullspace is None:
+        if pc_type in ("gamg", "hypre", "ml") or not isinstance(near_nullspace, str):
+            if near_nullspace == "global":
+                near_nullspace = rigid_body_modes(problem.V)
+            elif near_nullspace == "per_body":
                 near_nullspace = rigid_body_modes(problem.V, problem.body_cells)
             problem.A.setNearNullSpace(near_nullspace)
             problem.K.setNearNullSpace(near_nullspace)
-        self.near_nullspace = near_nullspace
+            self.near_nullspace = near_nullspace
+        else:
+            self.near_nullspace = None
         self._residuals: list = []
         self.snes.setMonitor(self._monitor)
 

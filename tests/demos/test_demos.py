@@ -113,3 +113,16 @@ def test_demo_punch_bem_vs_statistical(tmp_path):
     finally:
         del os.environ["ROUGH_CONTACT_CACHE"]
     assert "secant punch stiffness" in out
+
+
+def test_bench_solver_runs_every_option_set(tmp_path):
+    """benchmarks/bench_solver.py on the small punch, 2 ranks: one summary row per set, each
+    carrying the applied 250 N through the interface after the same Newton iterations."""
+    out = run([ROOT / "benchmarks" / "bench_solver.py", "--sizes", "small", "--sets", "mumps",
+               "mumps_lagged", "gamg", "hypre"], tmp_path, ranks=2 if MPIRUN else 1)
+    rows = [line.split() for line in out.splitlines()
+            if line.split()[:1] == ["small"] and len(line.split()) >= 12]
+    assert [r[2] for r in rows] == ["mumps", "mumps_lagged", "gamg", "hypre"]
+    for r in rows:
+        assert abs(float(r[10]) - 250.0) < 1e-6, r
+        assert all(1 <= int(k) <= 8 for k in r[3].split(",")), r

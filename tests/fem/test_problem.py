@@ -395,6 +395,31 @@ def test_programming_error_in_law_propagates_at_once(where):
     solver.destroy()
 
 
+def test_increments_count_the_work_of_failed_attempts():
+    """Every Newton and linear iteration spent is reported, failed attempts included.
+
+    Reference: PETSc's own monitors (a SNES monitor called once per finished Newton iteration)
+    and the number of Jacobian evaluations, each followed by one LU solve (1 linear iteration).
+    """
+    p, kn = 40.0, 1.0e5
+    law = StepLimitedPenalty(kn, limit=0.3 * p / kn)
+    scene, problem, solver, ci = blocks_problem(law, p, prefix="test_count_")
+    newton = []
+    solver.snes.setMonitor(lambda snes, its, norm: newton.append(its) if its > 0 else None)
+    solves = _count_solves(solver)
+    problem.reset_timings()
+    incs = list(load_path(problem, solver, [1.0], verbose=False))
+    failed = len(solves) - len(incs)
+    assert failed >= 2
+    assert sum(i.failed_attempts for i in incs) == failed
+    assert sum(i.newton_total for i in incs) == len(newton)
+    assert sum(i.linear_total for i in incs) == problem.counters["jacobian"]
+    # the failed attempts did linear solves that the converged attempts alone do not show
+    assert sum(i.linear_iterations for i in incs) < sum(i.linear_total for i in incs)
+    assert all(i.linear_iterations == i.iterations for i in incs)  # LU: 1 per Newton iteration
+    solver.destroy()
+
+
 @pytest.mark.parametrize("error", [ReturnMappingError, LocalNewtonError])
 def test_convergence_error_on_one_rank_cuts_back_on_every_rank(error):
     """A ConvergenceError raised on ONE rank (the first that owns interface points) makes every

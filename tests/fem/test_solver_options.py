@@ -16,7 +16,8 @@ from dolfinx import fem
 from rough_contact.scenes.meshes.blocks import block_on_plane
 from rough_contact.fem.problem import ContactProblem, Material, SurfaceLoad
 from rough_contact.solver.options import unused_options
-from rough_contact.solver.snes import SNESSolver, UnusedOptionsWarning
+from rough_contact.solver.snes import (AMG_DEFAULT, DEFAULT_DOF_THRESHOLD, LINEAR_SOLVERS,
+                                       SNESSolver, UnusedOptionsWarning)
 
 E, NU = 2.0e5, 0.25
 
@@ -84,7 +85,7 @@ def test_defaults_reach_options_read_at_the_first_solve():
     """Multigrid level smoothers are read when GAMG builds its hierarchy, inside the first
     solve, not at setFromOptions: the solver's defaults must still be there then."""
     problem = bulk_problem(10.0, mesh_size=0.25)
-    solver = SNESSolver(problem, prefix="lazy_", dof_threshold=0, defaults={
+    solver = SNESSolver(problem, prefix="lazy_", linear_solver="gamg", defaults={
         "mg_levels_ksp_type": "richardson", "mg_levels_pc_type": "sor",
         "pc_gamg_coarse_eq_limit": 50})
     problem.set_load_factor(1.0)
@@ -135,3 +136,93 @@ def test_bad_arguments():
         SNESSolver(problem, prefix="bad_", dof_threshold=-1)
     with pytest.raises(ValueError, match="load factor = nan"):
         problem.set_load_factor(np.nan)
+
+
+def uniaxial_error(problem, p):
+    """Max nodal error of the block's exact solution (uniaxial stress sigma_zz = -p)."""
+    from mpi4py import MPI
+
+    x = problem.V.tabulate_dof_coordinates()
+    u = problem.u.x.array.reshape(-1, 3)
+    exact = np.column_stack([NU * p / E * x[:, 0], NU * p / E * x[:, 1], -p / E * x[:, 2]])
+    return problem.comm.allreduce(float(np.max(np.abs(u - exact))), op=MPI.MAX)
+
+
+def test_size_rule_picks_mumps_then_amg():
+    problem = bulk_problem(10.0)
+    assert problem.num_dofs < DEFAULT_DOF_THRESHOLD
+    small = SNESSolver(problem, prefix="size1_")
+    assert small.option_set == "mumps" and small.linear_solver == "preonly+lu(mumps)"
+    assert small.near_nullspace is None
+    big = SNESSolver(bulk_problem(10.0), prefix="size2_", dof_threshold=problem.num_dofs - 1)
+    assert big.option_set == AMG_DEFAULT
+    assert big.linear_solver == f"gmres+{LINEAR_SOLVERS[AMG_DEFAULT]['pc_type']}"
+    for s in (small, big):
+        s.destroy()
+
+
+@pytest.mark.parametrize("option_set", ["gamg", "hypre"])
+def test_amg_sets_solve_to_the_exact_answer(option_set):
+    """Each AMG set, with the six global rigid-body modes and 3 x 3 blocks, solves the block
+    under pressure to its exact (uniaxial stress) solution."""
+    p = 10.0
+    problem = bulk_problem(p, mesh_size=0.25)
+    solver = SNESSolver(problem, prefix=f"amg_{option_set}_", linear_solver=option_set)
+    assert solver.linear_solver == f"gmres+{option_set}"
+    assert problem.A.getBlockSize() == 3
+    assert len(solver.near_nullspace.getVecs()) == 6
+    assert problem.A.getNearNullSpace() is not None
+    problem.set_load_factor(1.0)
+    result = solver.solve()
+    assert result.converged and result.linear_iterations > result.iterations
+    assert uniaxial_error(problem, p) < 1e-8 * p / E
+    assert solver.report_unused_options() == []
+    solver.destroy()
+
+
+def test_command_line_picks_the_set_and_overrides_single_options():
+    opts = PETSc.Options()
+    # -pc_type alone picks the whole GAMG set (GMRES + its tolerances), not just the PC
+    opts.setValue("pick1_pc_type", "gamg")
+    s1 = SNESSolver(bulk_problem(10.0), prefix="pick1_")
+    assert s1.option_set == "gamg" and s1.linear_solver == "gmres+gamg"
+    assert s1.snes.getKSP().getTolerances()[0] == LINEAR_SOLVERS["gamg"]["ksp_rtol"]
+    # -linear_solver wins over the size rule; a single option changes only itself
+    opts.setValue("pick2_linear_solver", "hypre")
+    opts.setValue("pick2_ksp_rtol", 1e-9)
+    opts.setValue("pick2_near_nullspace", "per_body")
+    problem = bulk_problem(10.0)
+    s2 = SNESSolver(problem, prefix="pick2_", linear_solver="mumps")
+    assert s2.option_set == "hypre" and s2.linear_solver == "gmres+hypre"
+    ksp = s2.snes.getKSP()
+    assert ksp.getTolerances()[0] == 1e-9
+    assert ksp.getTolerances()[3] == LINEAR_SOLVERS["hypre"]["ksp_max_it"]
+    problem.set_load_factor(1.0)
+    assert s2.solve().converged
+    assert s2.report_unused_options() == []  # linear_solver and near_nullspace were read
+    for s in (s1, s2):
+        s.destroy()
+    for name in ("pick1_pc_type", "pick2_linear_solver", "pick2_ksp_rtol",
+                 "pick2_near_nullspace"):
+        opts.delValue(name)
+
+
+def test_command_line_threshold():
+    opts = PETSc.Options()
+    problem = bulk_problem(10.0)
+    opts.setValue("thr_dof_threshold", problem.num_dofs - 1)
+    solver = SNESSolver(problem, prefix="thr_", dof_threshold=10**9)
+    assert solver.dof_threshold == problem.num_dofs - 1 and solver.option_set == AMG_DEFAULT
+    assert solver.report_unused_options() == []
+    solver.destroy()
+    opts.delValue("thr_dof_threshold")
+
+
+def test_bad_solver_choices():
+    problem = bulk_problem(10.0)
+    with pytest.raises(ValueError, match="linear solver = 'superlu' is invalid; valid values: "
+                                         "'auto', 'mumps'"):
+        SNESSolver(problem, prefix="bad1_", linear_solver="superlu")
+    with pytest.raises(ValueError, match="near_nullspace = 'local' is invalid"):
+        SNESSolver(problem, prefix="bad2_", linear_solver="gamg", near_nullspace="local")
+
