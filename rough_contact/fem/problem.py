@@ -78,11 +78,14 @@ class SurfaceLoad:
         tag: facet tag of the loaded surface.
         force: total force vector (3,) at load factor 1 [N].
         traction: traction vector (3,) at load factor 1 [MPa].
+        channel: name of the load channel that scales it (see ``ContactProblem(programs=)``;
+            by default every channel follows the load factor).
     """
 
     tag: int
     force: Optional[Sequence[float]] = None
     traction: Optional[Sequence[float]] = None
+    channel: str = "load"
 
     def __post_init__(self):
         if (self.force is None) == (self.traction is None):
@@ -111,11 +114,13 @@ class PrescribedDisplacement:
             DOF coordinates (a non-uniform field, e.g. a rotation), or a displacement Function
             on the problem's space (its values on the surface are used).
         components: the prescribed components (0, 1, 2 = x, y, z); the others stay free.
+        channel: name of the load channel that scales it (see ``ContactProblem(programs=)``).
     """
 
     tag: int
     value: object
     components: Sequence[int] = (0, 1, 2)
+    channel: str = "load"
 
     def __post_init__(self):
         comps = tuple(self.components)
@@ -197,6 +202,10 @@ class ContactProblem:
             near-nullspace built per body; empty = the six global rigid-body modes.
         prescribed: displacements prescribed on tagged surfaces, scaled by the load factor
             (:class:`PrescribedDisplacement`; ``facet_tags`` required).
+        programs: ``{channel: scale(t)}``: the scale of each load channel as a function of the
+            load factor (pseudo-time) t; a channel without a program follows t itself (today's
+            proportional loading). See ``rough_contact.solver.program`` for preload, hold and
+            cyclic programs.
 
     Raises:
         TypeError: ``interface`` is neither a ContactInterface nor None.
@@ -217,6 +226,7 @@ class ContactProblem:
         quadrature_degree: Optional[int] = None,
         body_cells: Sequence[np.ndarray] = (),
         prescribed: Sequence[PrescribedDisplacement] = (),
+        programs: Optional[dict] = None,
     ):
         if interface is not None and not isinstance(interface, ContactInterface):
             raise TypeError(f"interface must be a ContactInterface or None, got "
@@ -228,6 +238,17 @@ class ContactProblem:
         self.interface = interface
         self.body_cells = [np.asarray(c, dtype=np.int32) for c in body_cells]
         self.load_factor = 0.0
+        self.programs = dict(programs or {})
+        for name, fn in self.programs.items():
+            if not callable(fn):
+                raise TypeError(f"programs[{name!r}] must be a callable t -> scale, got "
+                                f"{type(fn).__name__}")
+        used = {x.channel for x in list(loads) + list(prescribed)}
+        unknown = sorted(set(self.programs) - used)
+        if unknown:
+            raise ValueError(f"programs given for channel(s) {unknown} that no load or prescribed "
+                             f"displacement uses; channels in use: {sorted(used)}")
+        self.scales = {c: 0.0 for c in used}
         self.u = fem.Function(V, name="displacement")
         self._prescribed = self._prescribed_bcs(list(prescribed), facet_tags)
         self.bcs += [bc for _, bc, *_ in self._prescribed]
@@ -261,9 +282,11 @@ class ContactProblem:
         self.a = fem.form(a)
         self._a_ufl, self._v = a, v
 
-        # External load vector at lam = 1; tractions from total forces use the surface area.
-        self.applied_force = np.zeros(3)
-        L = 0
+        # External load vectors at scale 1, one per channel; tractions from total forces use the
+        # surface area.
+        self.applied_force = np.zeros(3)          # all channels at scale 1
+        self._channel_force = {}
+        L, L_channel = 0, {}
         for load in self.loads:
             if facet_tags is None:
                 raise ValueError("surface loads need facet_tags")
@@ -278,7 +301,11 @@ class ContactProblem:
             else:
                 t = np.asarray(load.traction, dtype=float)
             self.applied_force += t * area
-            L += ufl.inner(fem.Constant(msh, t), v) * ds(load.tag)
+            self._channel_force[load.channel] = (self._channel_force.get(load.channel, 0.0)
+                                                 + t * area)
+            term = ufl.inner(fem.Constant(msh, t), v) * ds(load.tag)
+            L += term
+            L_channel[load.channel] = L_channel.get(load.channel, 0) + term
         if L == 0:
             L = ufl.inner(fem.Constant(msh, np.zeros(3)), v) * ufl.dx(domain=msh)
         self.L = fem.form(L)
@@ -297,7 +324,14 @@ class ContactProblem:
 
         self.f = fem_petsc.assemble_vector(self.L)
         self.f.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-        self.f_full = self.f.copy()          # with the constrained rows (for reactions)
+        # per channel, with the constrained rows (for reactions) and without (for the residual)
+        self._f_channel = {}
+        for name, form in L_channel.items():
+            full = fem_petsc.assemble_vector(fem.form(form))
+            full.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+            free = full.copy()
+            fem_petsc.set_bc(free, self.bcs, scale=0.0)
+            self._f_channel[name] = (free, full)
         fem_petsc.set_bc(self.f, self.bcs, scale=0.0)
         self.lift = self.f.duplicate()
         self.update_dirichlet()
@@ -335,7 +369,8 @@ class ContactProblem:
         self.update_solution(x)
         t0 = MPI.Wtime()
         self.K.mult(x, b)
-        b.axpy(-self.load_factor, self.f)
+        for name, (free, _) in self._f_channel.items():
+            b.axpy(-self.scales[name], free)
         b.axpy(1.0, self.lift)
         t1 = MPI.Wtime()
         if self.interface is not None:
@@ -376,10 +411,22 @@ class ContactProblem:
         times their nominal value (the lifting is recomputed when displacements are
         prescribed)."""
         self.load_factor = check_scalar("load factor", lam)
+        for name in self.scales:
+            fn = self.programs.get(name)
+            self.scales[name] = self.load_factor if fn is None else check_scalar(
+                f"scale of load channel {name!r} at t = {self.load_factor:g}", fn(self.load_factor))
         if self._prescribed:
-            for g, _, g1, *_ in self._prescribed:
-                g.x.array[:] = self.load_factor * g1
+            for g, _, g1, _, _, channel in self._prescribed:
+                g.x.array[:] = self.scales[channel] * g1
             self.update_dirichlet()
+
+    def current_applied_force(self) -> np.ndarray:
+        """(3,) total external surface force at the current load factor [N] (every channel at
+        its current scale)."""
+        f = np.zeros(3)
+        for name, force in self._channel_force.items():
+            f += self.scales[name] * force
+        return f
 
     def update_dirichlet(self) -> None:
         """Recompute the lifting K_full[:, bc] g from the current Dirichlet values (collective).
@@ -424,9 +471,9 @@ class ContactProblem:
                 else:
                     g1.x.array[:] = float(p.value[c])
                 g = fem.Function(Vc)
-                g.x.array[:] = self.load_factor * g1.x.array
+                g.x.array[:] = 0.0
                 out.append((g, fem.dirichletbc(g, dofs, self.V.sub(c)), g1.x.array.copy(), p.tag,
-                            c))
+                            c, p.channel))
         return out
 
     def reaction(self, tag: int) -> np.ndarray:
@@ -445,10 +492,11 @@ class ContactProblem:
             self._reaction_form = fem.form(ufl.action(self._a_ufl, self.u))
         r = fem_petsc.assemble_vector(self._reaction_form)
         r.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-        r.axpy(-self.load_factor, self.f_full)
+        for name, (_, full) in self._f_channel.items():
+            r.axpy(-self.scales[name], full)
         arr = r.getArray()
         total = np.zeros(3)
-        for _, bc, _, t, c in self._prescribed:
+        for _, bc, _, t, c, _ in self._prescribed:
             if t == tag:
                 dofs, n_owned = bc.dof_indices()
                 total[c] += float(arr[np.asarray(dofs)[:n_owned]].sum())

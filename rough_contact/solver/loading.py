@@ -283,7 +283,8 @@ def load_path(problem: ContactProblem, solver: SNESSolver, factors: Iterable[flo
                 inc = Increment(
                     step=step, load_factor=lam, target=target, iterations=result.iterations,
                     residual=result.residuals[-1] if result.residuals else float("nan"),
-                    residuals=list(result.residuals), applied_force=lam * problem.applied_force,
+                    residuals=list(result.residuals),
+                    applied_force=problem.current_applied_force(),
                     cutbacks=cutbacks, wall_time=time.perf_counter() - t_start,
                     linear_solver=solver.linear_solver, newton_total=spent[0],
                     linear_iterations=result.linear_iterations, linear_total=spent[1],

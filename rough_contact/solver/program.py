@@ -1,0 +1,168 @@
+"""Load programs: several load channels, each scaled by its own function of a pseudo-time.
+
+A program is a set of channel functions ``scale(t)`` and the pseudo-times of its increments.
+Loads and prescribed displacements name their channel (``SurfaceLoad(..., channel=)``,
+``PrescribedDisplacement(..., channel=)``); ``ContactProblem(..., programs=program.channels)``
+makes ``set_load_factor(t)`` scale each channel by its function, and ``load_path(problem, solver,
+program.times)`` steps through the program with the usual cutback (a cutback halves the
+pseudo-time increment, so every channel follows its own function between the increments).
+
+Programs built here (t is dimensionless; the nominal loads are those of the channels):
+
+* :func:`proportional`: one channel ``"load"`` = t, loading then unloading (today's default).
+* :func:`preload_then_hold`: channel ``preload`` ramps 0 -> 1 over t in [0, 1], then holds.
+* :func:`preload_then_cyclic`: ``preload`` ramps to 1 over t in [0, 1] and holds; ``cyclic``
+  is 0 during the preload, then ``amplitude x w(t - 1)`` with w a sine (sin 2 pi s) or a
+  triangle wave (0 -> 1 -> -1 -> 0 per unit s) for ``cycles`` cycles of unit length, with
+  ``steps_per_cycle`` increments each (a multiple of 4, so the extremes are increments).
+
+Units: none (scales multiply the channels' nominal values).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Callable, Dict, List
+
+import numpy as np
+
+from rough_contact.validation import check_scalar
+
+__all__ = ["LoadProgram", "proportional", "preload_then_hold", "preload_then_cyclic",
+           "cycle_index", "cycle_summary"]
+
+
+@dataclass(frozen=True)
+class LoadProgram:
+    """Channel functions and increment pseudo-times.
+
+    Attributes:
+        channels: ``{name: scale(t)}``.
+        times: pseudo-times of the increments, in order.
+        cycle_start: pseudo-time at which cycle 1 starts (``None`` for a program without cycles).
+    """
+
+    channels: Dict[str, Callable[[float], float]]
+    times: List[float]
+    cycle_start: float | None = None
+
+
+def _count(name: str, value, lo: int) -> int:
+    if check_scalar(name, value, lo=lo, lo_open=False) != int(value):
+        raise ValueError(f"{name} = {value!r} is invalid: it must be an integer >= {lo}")
+    return int(value)
+
+
+def proportional(n_load: int, n_unload: int = 0) -> LoadProgram:
+    """Channel ``"load"`` = t; t = 1/n_load ... 1, then down to 0 in ``n_unload`` steps."""
+    n_load = _count("n_load", n_load, 1)
+    n_unload = _count("n_unload", n_unload, 0)
+    times = [(i + 1) / n_load for i in range(n_load)]
+    times += [1.0 + (i + 1) / max(n_unload, 1) for i in range(n_unload)]
+    return LoadProgram({"load": lambda t: t if t <= 1.0 else 2.0 - t}, times)
+
+
+def _ramp_hold(t: float) -> float:
+    return min(max(t, 0.0), 1.0)
+
+
+def preload_then_hold(preload_steps: int, hold_steps: int = 1,
+                      preload: str = "preload") -> LoadProgram:
+    """``preload`` ramps 0 -> 1 in ``preload_steps`` increments, then stays at 1 for
+    ``hold_steps`` increments (t = 1 + k / hold_steps)."""
+    n = _count("preload_steps", preload_steps, 1)
+    m = _count("hold_steps", hold_steps, 0)
+    times = [(i + 1) / n for i in range(n)] + [1.0 + (i + 1) / max(m, 1) for i in range(m)]
+    return LoadProgram({preload: _ramp_hold}, times)
+
+
+def preload_then_cyclic(preload_steps: int, cycles: int, steps_per_cycle: int,
+                        amplitude: float = 1.0, shape: str = "triangle",
+                        preload: str = "preload", cyclic: str = "cyclic") -> LoadProgram:
+    """Preload to 1, hold it, and cycle the ``cyclic`` channel ``cycles`` times.
+
+    Args:
+        preload_steps: increments of the preload ramp (t in (0, 1]), >= 1.
+        cycles: number of cycles (each of unit pseudo-time), >= 1.
+        steps_per_cycle: increments per cycle, a multiple of 4 (>= 4).
+        amplitude: scale of the cyclic channel's extremes (> 0).
+        shape: ``"triangle"`` (0 -> a -> -a -> 0, linear) or ``"sine"``.
+        preload, cyclic: channel names.
+    """
+    n = _count("preload_steps", preload_steps, 1)
+    c = _count("cycles", cycles, 1)
+    k = _count("steps_per_cycle", steps_per_cycle, 4)
+    if k % 4:
+        raise ValueError(f"steps_per_cycle = {k} is invalid: it must be a multiple of 4 (the "
+                         "extremes and zero crossings are increments)")
+    a = check_scalar("amplitude", amplitude, lo=0.0)
+    if shape not in ("triangle", "sine"):
+        raise ValueError(f"shape = {shape!r} is invalid: it must be 'triangle' or 'sine'")
+
+    def wave(t: float) -> float:
+        if t <= 1.0:
+            return 0.0
+        s = (t - 1.0) % 1.0
+        if shape == "sine":
+            return a * math.sin(2.0 * math.pi * s)
+        return a * (4.0 * s if s <= 0.25 else 2.0 - 4.0 * s if s <= 0.75 else 4.0 * s - 4.0)
+
+    times = [(i + 1) / n for i in range(n)]
+    times += [1.0 + (j + 1) / k for j in range(c * k)]
+    return LoadProgram({preload: _ramp_hold, cyclic: wave}, times, cycle_start=1.0)
+
+
+def cycle_index(times, program: LoadProgram) -> np.ndarray:
+    """Cycle number (1, 2, ...) of each increment time, 0 before the first cycle (an increment
+    ending exactly at the end of a cycle belongs to that cycle)."""
+    t = np.asarray(times, dtype=float)
+    if program.cycle_start is None:
+        return np.zeros(t.shape, dtype=int)
+    s = t - program.cycle_start
+    return np.where(s <= 0.0, 0, np.ceil(s - 1e-9).astype(int))
+
+
+def cycle_summary(times, program: LoadProgram, displacement, force, dissipation) -> list:
+    """Per cycle of a cyclic program: the loop energy, the interface dissipation and the secant
+    stiffness.
+
+    Args:
+        times: (n,) pseudo-times of the converged increments.
+        program: the program (``cycle_start`` set).
+        displacement: (n,) the driven displacement (e.g. the prescribed u_x) [mm].
+        force: (n,) its work-conjugate force on the body (e.g. ``problem.reaction(tag)[0]``) [N].
+        dissipation: (n,) cumulative interface dissipation [N mm].
+
+    Returns:
+        One dict per complete cycle: ``cycle``, ``loop_energy`` (trapezoidal path integral of
+        F du over the cycle [N mm]), ``dissipated`` (interface dissipation of the cycle [N mm];
+        equal to the loop energy in a steady cycle), ``secant_stiffness`` ((F_max - F_min) /
+        (u_max - u_min) over the cycle [N/mm]).
+    """
+    from rough_contact.plotting import loop_energies
+
+    t = np.asarray(times, dtype=float)
+    u = np.asarray(displacement, dtype=float)
+    f = np.asarray(force, dtype=float)
+    d = np.asarray(dissipation, dtype=float)
+    if not (len(t) == len(u) == len(f) == len(d)):
+        raise ValueError(f"times, displacement, force and dissipation must have equal lengths, "
+                         f"got {len(t)}, {len(u)}, {len(f)}, {len(d)}")
+    k = cycle_index(t, program)
+    out = []
+    for c in range(1, int(k.max(initial=0)) + 1):
+        idx = np.flatnonzero(k == c)
+        before = np.flatnonzero(k < c)
+        if idx.size == 0 or before.size == 0:
+            continue
+        if not np.isclose(t[idx[-1]] - program.cycle_start, c):
+            continue                     # incomplete cycle (a run stopped inside it)
+        s, e = int(before[-1]), int(idx[-1])
+        span = slice(s, e + 1)
+        du = u[span].max() - u[span].min()
+        out.append(dict(cycle=c, loop_energy=float(loop_energies(u, f, [s, e])[0]),
+                        dissipated=float(d[e] - d[s]),
+                        secant_stiffness=float((f[span].max() - f[span].min()) / du)
+                        if du > 0 else float("nan")))
+    return out
