@@ -126,3 +126,21 @@ def test_bench_solver_runs_every_option_set(tmp_path):
     for r in rows:
         assert abs(float(r[10]) - 250.0) < 1e-6, r
         assert all(1 <= int(k) <= 8 for k in r[3].split(",")), r
+
+
+def test_demo_fretting(tmp_path):
+    """Two amplitudes on 2 ranks: no slip at 0.3 um (elastic loop), slip at 4 um (positive
+    energy, lower secant stiffness); the CSV holds one row per amplitude and cycle."""
+    ranks = 2 if MPIRUN else 1
+    out = run([DEMOS / "demo_fretting.py", "--amplitudes", "0.3", "4", "--cycles", "1",
+               "--steps-per-cycle", "8", "--outdir", tmp_path / "fret"], tmp_path, ranks)
+    assert "energy per cycle" in out
+    import csv
+
+    with open(tmp_path / "fret" / "cycles.csv") as f:
+        rows = list(csv.DictReader(f))
+    assert [(r["amplitude_um"], r["cycle"]) for r in rows] == [("0.3", "1"), ("4.0", "1")]
+    e = [float(r["loop_energy_Nmm"]) for r in rows]
+    k = [float(r["secant_stiffness_N_per_mm"]) for r in rows]
+    assert abs(e[0]) < 1e-9 * e[1] and e[1] > 0 and k[1] < k[0]
+    assert (tmp_path / "fret" / "fretting.png").exists()
