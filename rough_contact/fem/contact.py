@@ -56,6 +56,8 @@ import dolfinx
 import dolfinx.cpp
 import dolfinx.fem
 from rough_contact.fem.collective import raise_on_all_ranks
+from rough_contact.fem.rigid import RigidPlane as RigidPlaneSurface
+from rough_contact.fem.rigid import RigidSurface
 from rough_contact.interface.contract import (
     ConvergenceError,
     InterfaceLawProtocol,
@@ -199,6 +201,10 @@ class ContactInterface:
             ``initial_state(n)`` and ``evaluate(jump, committed) -> LawResult``).
         rigid_plane: for ``second_tag=None``: (point (3,), unit normal (3,) pointing towards the
             first body) [mm]; None = a plane tangent to the first surface at every point.
+        rigid: for ``second_tag=None``: any rigid counter-surface
+            (:class:`rough_contact.fem.rigid.RigidSurface`: plane, sphere, cylinder, signed
+            distance); its gap and normal are evaluated at set-up and linearised (small
+            sliding, see ``rough_contact.fem.rigid``). Give ``rigid`` or ``rigid_plane``.
         grain_direction: (3,) global direction projected on the facet to give the local x axis.
         quadrature_degree: degree (integer >= 0) of the facet quadrature rule (Gauss).
         quadrature: ``"gauss"`` (default: Gauss points of ``quadrature_degree``) or
@@ -233,6 +239,7 @@ class ContactInterface:
         *,
         law: InterfaceLawProtocol,
         rigid_plane: Optional[RigidPlane] = None,
+        rigid: Optional[RigidSurface] = None,
         grain_direction: Sequence[float] = (1.0, 0.0, 0.0),
         quadrature_degree: int = 2,
         quadrature: str = "gauss",
@@ -242,6 +249,17 @@ class ContactInterface:
         self.comm = V.mesh.comm
         self.V = V
         self.law = law
+        if rigid is not None:
+            if rigid_plane is not None:
+                raise ValueError("give either rigid or rigid_plane, not both")
+            if second_tag is not None:
+                raise ValueError("give either second_tag or rigid, not both")
+            if not isinstance(rigid, RigidSurface):
+                raise TypeError(f"rigid ({type(rigid).__name__}) must implement "
+                                "rough_contact.fem.rigid.RigidSurface (gap_and_normal(x))")
+        elif rigid_plane is not None:
+            _plane(rigid_plane)                         # validates with its own message
+            rigid = RigidPlaneSurface(*rigid_plane)     # normalises once, as before
         grain, degree = _check_arguments(V, law, first_tag, second_tag, rigid_plane,
                                          quadrature_degree, grain_direction, match_tolerance,
                                          quadrature)
@@ -252,7 +270,7 @@ class ContactInterface:
                                                       self.comm))
         self._facets1 = geo1.facets
         xq, normal, N1 = self._first_surface(geo1, rule)
-        R = self._local_axes(xq, normal, grain, rigid_plane)
+        R = self._local_axes(xq, normal, grain, rigid)
         if second_tag is None:
             N2 = nodes2 = None
             self.n_remote_partners = 0
@@ -300,17 +318,17 @@ class ContactInterface:
         return xq, normal, N1
 
     def _local_axes(self, xq: np.ndarray, normal: np.ndarray, grain: np.ndarray,
-                    rigid_plane: Optional[RigidPlane]) -> np.ndarray:
-        """Local frames (n, x, y) per point and the initial gap to a rigid plane (collective).
+                    rigid: Optional[RigidSurface]) -> np.ndarray:
+        """Local frames (n, x, y) per point and the initial gap to a rigid surface (collective).
 
         Returns:
             R: (n_f, nq, 3 local, 3 global) rows n, x, y.
         """
         jump0 = np.zeros(xq.shape)
-        if rigid_plane is not None:
-            point, pnormal = _plane(rigid_plane)
-            normal = np.broadcast_to(-pnormal, normal.shape).copy()
-            jump0[..., 0] = (xq - point) @ pnormal
+        if rigid is not None:
+            g0, rnormal = rigid.gap_and_normal(xq.reshape(-1, 3))
+            normal = -np.asarray(rnormal, dtype=float).reshape(normal.shape)
+            jump0[..., 0] = np.asarray(g0, dtype=float).reshape(jump0.shape[:-1])
         gx = grain - np.einsum("fqi,i->fq", normal, grain)[..., None] * normal
         gnorm = np.linalg.norm(gx, axis=-1)
         bad = gnorm < 1e-6 * np.linalg.norm(grain)

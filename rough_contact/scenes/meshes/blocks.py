@@ -22,10 +22,11 @@ import numpy as np
 from mpi4py import MPI
 
 from rough_contact.fem.mesh import (Scene, add_groups, build_scene, entity_centers,
+                                    refine_towards,
                                     set_transfinite_hexahedra, validate_cell_type,
                                     validate_order, validate_positive)
 
-__all__ = ["two_blocks", "block_on_plane"]
+__all__ = ["two_blocks", "block_on_plane", "indented_block"]
 
 
 def _side_groups(model, lx, ly, tol):
@@ -129,6 +130,51 @@ def block_on_plane(lx: float = 1.0, ly: float = 1.0, h: float = 1.0,
         comm, "block_on_plane", build, split_body="block", contact_pair=("contact", None),
         rigid_plane=(np.zeros(3), np.array([0.0, 0.0, 1.0])),
         dimensions=dict(lx=lx, ly=ly, h=h, mesh_size=mesh_size))
+
+
+def indented_block(half_width: float = 4.0, height: float = 4.0, mesh_size: float = 1.0,
+                   contact_size: float = 0.05, transition: float = 1.0,
+                   refined_radius: float = 0.4, order: int = 1,
+                   comm: MPI.Comm = MPI.COMM_WORLD) -> Scene:
+    """Quarter of a block [0, L] x [0, L] x [-H, 0] for an indenter touching its top at the
+    origin: element size ``contact_size`` within ``refined_radius`` of the origin, growing to
+    ``mesh_size`` over a further ``transition`` [mm]. Collective.
+
+    Labels: "block" (1); "contact" (11): top z = 0; "bottom" (14): z = -H;
+    "symmetry_x" (17): x = 0; "symmetry_y" (18): y = 0.
+    The scene's rigid plane (metadata only) is z = 0 with normal -z; pass the real indenter
+    to ``ContactInterface(rigid=...)``.
+    """
+    validate_positive(half_width=half_width, height=height, mesh_size=mesh_size,
+                      contact_size=contact_size, transition=transition,
+                      refined_radius=refined_radius)
+    validate_order(order)
+    tol = 1e-6 * max(half_width, height)
+
+    def build(model):
+        box = model.occ.addBox(0, 0, -height, half_width, half_width, height)
+        model.occ.synchronize()
+        add_groups(model, 3, {"block": (1, [box])})
+        tags, c = entity_centers(model, 2)
+        add_groups(model, 2, {"contact": (11, tags[np.abs(c[:, 2]) < tol]),
+                              "bottom": (14, tags[np.abs(c[:, 2] + height) < tol]),
+                              "symmetry_x": (17, tags[np.abs(c[:, 0]) < tol]),
+                              "symmetry_y": (18, tags[np.abs(c[:, 1]) < tol])})
+        r = "Sqrt(x^2+y^2+z^2)"
+        refine_towards(model, f"(Abs({r}-{refined_radius})+{r}-{refined_radius})/2",
+                       contact_size, mesh_size, transition)
+        model.mesh.generate(3)
+        if order == 2:
+            import gmsh
+
+            gmsh.option.setNumber("Mesh.SecondOrderIncomplete", 0)
+            model.mesh.setOrder(2)
+
+    return build_scene(
+        comm, "indented_block", build, split_body="block", contact_pair=("contact", None),
+        rigid_plane=(np.zeros(3), np.array([0.0, 0.0, -1.0])),
+        dimensions=dict(half_width=half_width, height=height, mesh_size=mesh_size,
+                        contact_size=contact_size))
 
 
 def main(argv=None) -> None:
