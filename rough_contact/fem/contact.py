@@ -694,6 +694,14 @@ class ContactInterface:
         return self.comm.allreduce(float(np.dot(self.history.dissipated, self._weights)),
                                    op=MPI.SUM)
 
+    def mean_normal(self) -> np.ndarray:
+        """(3,) area-weighted mean unit normal of the first surface (towards the second body),
+        global axes (collective)."""
+        n = self.comm.allreduce(np.einsum("pi,p->i", self._R[:, 0, :], self._weights),
+                                op=MPI.SUM)
+        norm = np.linalg.norm(n)
+        return n / norm if norm > 0 else n
+
     def n_contact(self) -> int:
         """Global number of points in contact (p > 0) at the last evaluation (collective, one
         allreduce: cheap enough for every Jacobian)."""

@@ -191,6 +191,18 @@ class InterfaceLawProtocol(Protocol):
         ...
 
 
+@runtime_checkable
+class FrictionBoundedLaw(Protocol):
+    """A law whose tangential traction is bounded by a friction coefficient times the pressure:
+    |t_T| <= mu_max p at every point and state. The load stepping uses the bound to recognise a
+    tangential load that no friction can carry (a sliding body) instead of cutting back."""
+
+    def max_friction_coefficient(self) -> float:
+        """The largest friction coefficient the law can reach (saturated, over all directions);
+        0 for a frictionless law."""
+        ...
+
+
 def check_jump(jump, committed: LawState) -> np.ndarray:
     """Validate the arguments of ``evaluate`` as the contract requires; return the jump.
 

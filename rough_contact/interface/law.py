@@ -112,6 +112,13 @@ class InterfaceLaw:
         if self.h0 is not None:
             object.__setattr__(self, "h0", check_scalar("h0", self.h0, unit="mm"))
 
+    def max_friction_coefficient(self) -> float:
+        """Largest friction coefficient reachable (the saturated mu_macro, largest axis); 0
+        without friction (``rough_contact.interface.contract.FrictionBoundedLaw``)."""
+        if self.friction is None:
+            return 0.0
+        return float(np.max(self.friction.mu_macro))
+
     def with_seating(self, p_seat: float) -> InterfaceLaw:
         """Copy whose h0 solves p(h0) = p_seat [MPa] (zero gap carries the seating pressure).
 

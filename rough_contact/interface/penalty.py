@@ -116,6 +116,11 @@ class SoftplusPenalty:
         """Virgin history (no plastic slip) at n_pts points."""
         return InterfaceState.zeros(n_pts)
 
+    def max_friction_coefficient(self) -> float:
+        """mu (0 without tangential stiffness): |t_T| <= mu p
+        (``rough_contact.interface.contract.FrictionBoundedLaw``)."""
+        return float(self.friction) if self.k_tangential > 0.0 else 0.0
+
     def normal(self, g: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Pressure p(g) [MPa] and stiffness k = -dp/dg [MPa/mm] at gaps g (n,) [mm]."""
         z = -np.asarray(g, dtype=float) / self.width

@@ -46,12 +46,12 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from rough_contact.fem.problem import ContactProblem
-from rough_contact.interface.contract import ConvergenceError
+from rough_contact.interface.contract import ConvergenceError, FrictionBoundedLaw
 from rough_contact.solver.snes import SNESSolver, SolveResult
 from rough_contact.validation import check_scalar
 
-__all__ = ["Increment", "LoadStepError", "ModelValidityError", "ModelValidityWarning", "load_path",
-           "load_unload_factors"]
+__all__ = ["Increment", "LoadStepError", "FrictionCapacityError", "ModelValidityError",
+           "ModelValidityWarning", "load_path", "load_unload_factors"]
 
 VALIDITY_POLICIES = ("warn", "error", "ignore")
 PREDICTORS = ("secant", "none")
@@ -90,6 +90,20 @@ class LoadStepError(RuntimeError):
         super().__init__(message)
         self.load_factor = load_factor
         self.last_converged = last_converged
+
+
+class FrictionCapacityError(LoadStepError):
+    """Raised instead of a cutback when the tangential load demanded by the failing step exceeds
+    what friction can carry, mu_max times the normal load: the body slides and no smaller
+    increment reaches the target.
+
+    Attributes (besides LoadStepError's): tangential, capacity [N].
+    """
+
+    def __init__(self, message, load_factor, last_converged, tangential, capacity):
+        super().__init__(message, load_factor, last_converged)
+        self.tangential = tangential
+        self.capacity = capacity
 
 
 @dataclass
@@ -193,7 +207,7 @@ def _print_increment(inc: Increment) -> None:
 def load_path(problem: ContactProblem, solver: SNESSolver, factors: Iterable[float], *,
               min_increment: float = 1e-4, max_growth: float = 2.0,
               verbose: bool = True, validity: str = "warn",
-              predictor: str = "secant") -> Iterator[Increment]:
+              predictor: str = "secant", friction_check: bool = True) -> Iterator[Increment]:
     """Follow ``factors`` with Newton solves; yield after each converged, committed step.
 
     Args:
@@ -218,6 +232,12 @@ def load_path(problem: ContactProblem, solver: SNESSolver, factors: Iterable[flo
             depend on the choice (to the Newton tolerance), the iteration count does
             (docs/coulomb.md: -67 % / -52 % on the Coulomb punch at mu = 0.2 / 0.5, -19 % on
             the rough punch).
+
+        friction_check: when a step fails to converge and the law bounds friction
+            (``FrictionBoundedLaw``), compare the tangential part of the applied surface force
+            (relative to the first surface's mean normal) with mu_max times its normal part;
+            if it is larger, raise :class:`FrictionCapacityError` instead of cutting back (the
+            body slides). Turn it off for a body that other supports hold tangentially.
 
     Yields:
         :class:`Increment` per converged step.
@@ -307,6 +327,7 @@ def load_path(problem: ContactProblem, solver: SNESSolver, factors: Iterable[flo
                     delta *= max_growth
                 continue
             # Failure to converge: revert to the committed state and halve the increment.
+            f_failed = problem.current_applied_force()     # the load the failed step asked for
             spent[2] += 1
             u_committed.copy(problem.u.vector)
             problem.u.x.scatter_forward()
@@ -317,6 +338,9 @@ def load_path(problem: ContactProblem, solver: SNESSolver, factors: Iterable[flo
                 why = f"{type(failure).__name__}: {failure}"
             else:
                 why = f"{result.reason_name} after {result.iterations} its"
+            if friction_check and interface is not None and isinstance(interface.law,
+                                                                      FrictionBoundedLaw):
+                _check_friction_capacity(interface, f_failed, lam, target, lam_committed, why)
             delta *= 0.5
             cutbacks += 1
             if abs(delta) < min_increment:
@@ -327,6 +351,27 @@ def load_path(problem: ContactProblem, solver: SNESSolver, factors: Iterable[flo
             if verbose:
                 PETSc.Sys.Print(f"  load {lam:.6g} failed ({why}): cutback to increment "
                                 f"{delta:.4g}")
+
+
+def _check_friction_capacity(interface, f, lam, target, lam_committed, why) -> None:
+    """Raise FrictionCapacityError if the tangential part of the applied force ``f`` (3,) [N]
+    of the failed step exceeds mu_max times its normal part."""
+    mu = float(interface.law.max_friction_coefficient())
+    n = interface.mean_normal()
+    normal = abs(float(f @ n))
+    tangential = float(np.linalg.norm(f - (f @ n) * n))
+    capacity = mu * normal
+    if tangential > capacity * (1.0 + 1e-9) + 1e-12 * max(tangential, normal):
+        excess = tangential - capacity
+        raise FrictionCapacityError(
+            f"load step to load factor {lam:.6g} (target {target:.6g}) failed ({why}) and the "
+            f"applied tangential force {tangential:.6g} N exceeds what friction can carry, "
+            f"mu_max x normal force = {mu:.4g} x {normal:.6g} N = {capacity:.6g} N, by "
+            f"{excess:.6g} N ({100 * excess / max(capacity, 1e-300):.3g} %): the body slides, no "
+            "smaller increment reaches it. Lower the tangential load, raise the normal load, or "
+            "drive the motion by a prescribed displacement; if other supports hold the body "
+            f"tangentially, pass friction_check=False. Last converged load factor "
+            f"{lam_committed:.6g} is committed", lam, lam_committed, tangential, capacity)
 
 
 def _check_initial_guess(problem: ContactProblem) -> None:

@@ -248,3 +248,17 @@ def test_rough_law_reports_points_below_the_table(gw_normal, name):
 def test_penalty_laws_have_no_validity_limit():
     for law in (LinearPenalty(1e4, 2e3, unilateral=True), SoftplusPenalty(1e4, 1e-3, 5e3, 0.3)):
         assert law.evaluate(np.full((2, 3), -1.0), law.initial_state(2)).beyond_validity is None
+
+
+def test_friction_bounded_laws(gw_normal):
+    from rough_contact.interface.contract import FrictionBoundedLaw
+
+    laws = built_in_laws(gw_normal)
+    assert laws["rough_ortho"].max_friction_coefficient() == 0.5        # saturated, largest axis
+    assert laws["rough_iso"].max_friction_coefficient() == 0.4
+    assert laws["rough_frictionless"].max_friction_coefficient() == 0.0
+    assert laws["softplus_penalty"].max_friction_coefficient() == 0.3
+    assert SoftplusPenalty(1e4, 1e-3).max_friction_coefficient() == 0.0  # no tangential stiffness
+    assert all(isinstance(laws[k], FrictionBoundedLaw) for k in
+               ("rough_ortho", "rough_iso", "rough_frictionless", "softplus_penalty"))
+    assert not isinstance(laws["linear_penalty"], FrictionBoundedLaw)   # unbounded spring

@@ -1,0 +1,67 @@
+"""A tangential load beyond what friction can carry stops with a clear error instead of a
+cutback spiral (serial and 2 ranks).
+
+Two blocks (P1); the upper one is held only by the interface (Coulomb penalty, mu = 0.3): a
+normal preload P is applied, then a tangential force ramps to Q_max on its top. Q_max = 0.2 P:
+the program converges. Q_max = 0.5 P: the step at Q = 0.375 P (> mu P = 0.3 P) cannot converge
+and ``load_path`` raises FrictionCapacityError naming 0.375 P, the capacity 0.3 P and the excess
+(25 %), at once (no cutback). Units: mm, N, MPa.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from petsc4py import PETSc
+
+from dolfinx import fem
+from rough_contact.fem.contact import ContactInterface
+from rough_contact.fem.problem import ContactProblem, Material, SurfaceLoad
+from rough_contact.interface.penalty import SoftplusPenalty
+from rough_contact.scenes.meshes.blocks import two_blocks
+from rough_contact.solver.loading import FrictionCapacityError, load_path
+from rough_contact.solver.snes import SNESSolver
+
+MU, P = 0.3, 100.0
+TIMES = [0.5, 1.0, 1.25, 1.5, 1.75, 2.0]
+
+
+def _model(q_max):
+    scene = two_blocks(h1=0.5, h2=0.5, mesh_size=0.5, order=1)
+    V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", 1))
+    clamp = fem.dirichletbc(np.zeros(3, dtype=PETSc.ScalarType), fem.locate_dofs_topological(
+        V, 2, scene.facet_tags.find(scene.tag("bottom"))), V)
+    law = SoftplusPenalty(k_normal=1e7, width=1e-9, k_tangential=1e7, friction=MU)
+    first, second = scene.contact_pair
+    ci = ContactInterface(V, scene.facet_tags, first, second, law=law, bcs=[clamp])
+    top = scene.tag("top")
+    problem = ContactProblem(
+        V, Material(2e5, 0.3), [clamp],
+        [SurfaceLoad(top, force=(0.0, 0.0, -P), channel="preload"),
+         SurfaceLoad(top, force=(q_max, 0.0, 0.0), channel="shear")],
+        facet_tags=scene.facet_tags, interface=ci, seating_tag=first, seating_stiffness=1e3,
+        programs={"preload": lambda t: min(t, 1.0), "shear": lambda t: max(t - 1.0, 0.0)})
+    return problem, SNESSolver(problem, prefix="fc_")
+
+
+def test_tangential_load_within_friction_converges():
+    problem, solver = _model(0.2 * P)
+    incs = list(load_path(problem, solver, TIMES, verbose=False))
+    assert [i.load_factor for i in incs] == TIMES
+    np.testing.assert_allclose(incs[-1].contact_force[:2], [-0.2 * P, 0.0], atol=1e-6 * P)
+    solver.destroy()
+
+
+def test_tangential_load_beyond_friction_stops_with_the_excess():
+    problem, solver = _model(0.5 * P)
+    done = []
+    with pytest.raises(FrictionCapacityError, match=(
+            r"load step to load factor 1.75 .* applied tangential force 37.5 N exceeds what "
+            r"friction can carry, mu_max x normal force = 0.3 x 100 N = 30 N, by 7.5 N \(25 %\): "
+            r"the body slides")) as err:
+        for inc in load_path(problem, solver, TIMES, verbose=False):
+            done.append(inc)
+    assert [i.load_factor for i in done] == [0.5, 1.0, 1.25, 1.5]     # no cutback before
+    assert err.value.tangential == pytest.approx(37.5) and err.value.capacity == pytest.approx(30)
+    assert err.value.last_converged == 1.5
+    solver.destroy()
