@@ -20,6 +20,10 @@ friction return map, a non-finite jump, traction or tangent), which the interfac
 every rank together. Any other exception (bad input, a programming error, a ``PETSc.Error``)
 propagates at once with its type and traceback: no cutback, no LoadStepError.
 
+A failed step whose applied tangential force exceeds what friction can carry (mu_max of a
+``FrictionBoundedLaw`` times the applied normal force) raises :class:`FrictionCapacityError`
+(a ``LoadStepError``) at once instead of cutting back: the body slides (``friction_check``).
+
 Guards before and after each solve:
 
 * the starting displacement must be finite: a NaN/inf initial guess is refused (``ValueError``
