@@ -110,6 +110,21 @@ class StatePair:
         self.dissipated = self.dissipated + self._pending
         self._pending = np.zeros_like(self.dissipated)
 
+    def restore(self, committed: LawState, dissipated: np.ndarray) -> None:
+        """Set the committed state and the accumulated dissipation (resuming a checkpoint)."""
+        if not isinstance(committed, LawState) or len(committed) != len(self.committed):
+            raise ValueError(f"restored state ({type(committed).__name__}, "
+                             f"{len(committed) if isinstance(committed, LawState) else '?'} "
+                             f"points) must be a LawState of {len(self.committed)} points")
+        d = np.asarray(dissipated, dtype=float)
+        if d.shape != self.dissipated.shape:
+            raise ValueError(f"restored dissipation of shape {d.shape}, expected "
+                             f"{self.dissipated.shape}")
+        self.committed = committed.copy()
+        self.trial = committed.copy()
+        self.dissipated = d.copy()
+        self._pending = np.zeros_like(self.dissipated)
+
     def revert(self) -> None:
         """Discard the trial state and its dissipation (the global Newton failed; cutback)."""
         self.trial = self.committed.copy()

@@ -51,6 +51,8 @@ from petsc4py import PETSc
 
 from rough_contact.fem.problem import ContactProblem
 from rough_contact.interface.contract import ConvergenceError, FrictionBoundedLaw
+from rough_contact.solver.checkpoint import CheckpointState, read_checkpoint, write_checkpoint
+from rough_contact.solver.checkpoint import signature as checkpoint_signature
 from rough_contact.solver.snes import SNESSolver, SolveResult
 from rough_contact.validation import check_scalar
 
@@ -211,7 +213,9 @@ def _print_increment(inc: Increment) -> None:
 def load_path(problem: ContactProblem, solver: SNESSolver, factors: Iterable[float], *,
               min_increment: float = 1e-4, max_growth: float = 2.0,
               verbose: bool = True, validity: str = "warn",
-              predictor: str = "secant", friction_check: bool = True) -> Iterator[Increment]:
+              predictor: str = "secant", friction_check: bool = True,
+              checkpoint: Optional[str] = None,
+              resume: Optional[str] = None) -> Iterator[Increment]:
     """Follow ``factors`` with Newton solves; yield after each converged, committed step.
 
     Args:
@@ -242,6 +246,11 @@ def load_path(problem: ContactProblem, solver: SNESSolver, factors: Iterable[flo
             (relative to the first surface's mean normal) with mu_max times its normal part;
             if it is larger, raise :class:`FrictionCapacityError` instead of cutting back (the
             body slides). Turn it off for a body that other supports hold tangentially.
+        checkpoint: directory receiving a checkpoint after every converged increment
+            (``rough_contact.solver.checkpoint``: atomic, two alternating slots).
+        resume: directory of a checkpoint to continue from: the problem (built afresh, same
+            mesh, ranks and law) gets its displacement, interface history and load factor, and
+            the stepping continues where the checkpointed run stopped (same ``factors``).
 
     Yields:
         :class:`Increment` per converged step.
@@ -261,17 +270,32 @@ def load_path(problem: ContactProblem, solver: SNESSolver, factors: Iterable[flo
         raise ValueError(f"validity = {validity!r} is invalid: it must be one of "
                          f"{', '.join(VALIDITY_POLICIES)}")
     comm = problem.comm
+    factors = list(factors)
+    restored = None
+    if resume is not None:
+        restored = read_checkpoint(resume, problem, factors)
+    sig = None if checkpoint is None else checkpoint_signature(problem)
     _check_initial_guess(problem)
     interface = problem.interface
     u_committed = problem.u.vector.copy()
     lam_committed = problem.load_factor
     u_previous, lam_previous = None, None     # the converged state before u_committed
     step = 0
+    start_index = 0
+    if restored is not None:
+        step, start_index, lam_previous = restored.step, restored.index, restored.lam_previous
+        if restored.u_previous is not None:
+            u_previous = u_committed.duplicate()
+            u_previous.setArray(restored.u_previous)
     spent = [0, 0, 0]  # Newton its, linear its, failed attempts since the last converged step
     for i, target in enumerate(factors):
+        if i < start_index:
+            continue
         target = check_scalar(f"load factor {i} of the load path", target)
         delta = target - lam_committed
         cutbacks = 0
+        if restored is not None and i == restored.index:
+            delta, cutbacks = restored.delta, restored.cutbacks
         t_start = time.perf_counter()
         while True:
             if abs(target - lam_committed) <= 1e-14 * max(1.0, abs(target)):
@@ -321,6 +345,12 @@ def load_path(problem: ContactProblem, solver: SNESSolver, factors: Iterable[flo
                     inc.contact_force, inc.real_area = s.contact_force, s.real_area
                     inc.dissipation = s.dissipation
                     inc.n_beyond_validity = s.n_beyond_validity
+                if checkpoint is not None:
+                    write_checkpoint(checkpoint, problem, CheckpointState(
+                        step=step, index=i, delta=delta * max_growth if cutbacks else delta,
+                        cutbacks=cutbacks, load_factor=lam, lam_previous=lam_previous,
+                        u_previous=None if u_previous is None else u_previous.getArray().copy(),
+                        factors=factors), sig)
                 if verbose:
                     _print_increment(inc)
                 if inc.n_beyond_validity and validity != "ignore":

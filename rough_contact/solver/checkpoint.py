@@ -1,0 +1,164 @@
+"""Checkpoints of a load path: write after every converged increment, resume a stopped run.
+
+``load_path(..., checkpoint=DIR)`` writes, after every converged (committed) increment and
+before it is yielded, everything the stepping needs to continue exactly: the displacement, the
+interface's committed law state and accumulated dissipation, the load factor, the position in
+the list of load factors (index, current increment size, cutbacks) and the secant predictor's
+previous state. ``load_path(..., resume=DIR)`` restores it into a freshly built problem (same
+mesh, same number of ranks, same law) and continues; the resumed run reproduces the uninterrupted
+one to round-off (tests/fem/test_checkpoint.py). The output writers are not part of the
+checkpoint: a resumed run writes its own output folder from the resumed increment on.
+
+Atomicity: two slots ``slot0/`` and ``slot1/`` are written alternately (one ``rank<r>.pkl`` per
+rank, then ``meta.json``); the file ``LATEST`` naming the complete slot is replaced atomically
+(``os.replace``) only after every rank has written and flushed its file. A run killed at any
+moment leaves ``LATEST`` pointing at a complete slot.
+
+Refused with a clear error: a directory without a checkpoint, a different number of ranks,
+another mesh or partition (DOF counts or a checksum of the DOF coordinates differ), another law
+(type or number of interface points), or a load-factor list that does not match the saved one.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import pickle
+from dataclasses import dataclass
+from typing import Optional
+
+import numpy as np
+from mpi4py import MPI
+
+__all__ = ["CheckpointState", "CheckpointError", "signature", "write_checkpoint",
+           "read_checkpoint"]
+
+
+class CheckpointError(ValueError):
+    """A checkpoint that cannot be resumed into this problem (the message says why)."""
+
+
+@dataclass
+class CheckpointState:
+    """The load path's position (identical on every rank) and this rank's arrays."""
+
+    step: int
+    index: int
+    delta: float
+    cutbacks: int
+    load_factor: float
+    lam_previous: Optional[float]
+    u_previous: Optional[np.ndarray]
+    factors: list
+
+
+def signature(problem) -> dict:
+    """What identifies the problem a checkpoint belongs to (collective)."""
+    V = problem.V
+    x = V.tabulate_dof_coordinates()[: V.dofmap.index_map.size_local]
+    local = float(np.round(x, 9).sum() + 7.0 * np.round(x ** 2, 9).sum())
+    ci = problem.interface
+    return dict(
+        ranks=problem.comm.size, num_dofs=int(problem.num_dofs),
+        dof_checksum=float(problem.comm.allreduce(local, op=MPI.SUM)),
+        law=None if ci is None else type(ci.law).__name__,
+        n_points=0 if ci is None else int(ci.n_points_global))
+
+
+def write_checkpoint(directory: str, problem, state: CheckpointState, sig: dict) -> None:
+    """Write one checkpoint (collective); ``sig`` = :func:`signature` of the problem (computed
+    once). See the module for the layout and atomicity."""
+    comm = problem.comm
+    if comm.rank == 0:
+        os.makedirs(directory, exist_ok=True)
+    comm.Barrier()
+    latest = _latest(directory) if comm.rank == 0 else None
+    slot = comm.bcast("slot1" if latest == "slot0" else "slot0", root=0)
+    path = os.path.join(directory, slot)
+    if comm.rank == 0:
+        os.makedirs(path, exist_ok=True)
+        for name in os.listdir(path):                      # stale files of an older checkpoint
+            os.remove(os.path.join(path, name))
+    comm.Barrier()
+    ci = problem.interface
+    data = dict(u=problem.u.x.array.copy(), u_previous=state.u_previous,
+                committed=None if ci is None else ci.history.committed,
+                dissipated=None if ci is None else ci.history.dissipated)
+    with open(os.path.join(path, f"rank{comm.rank}.pkl"), "wb") as f:
+        pickle.dump(data, f, protocol=pickle.HIGHEST_PROTOCOL)
+        f.flush()
+        os.fsync(f.fileno())
+    comm.Barrier()
+    if comm.rank == 0:
+        meta = dict(signature=sig, step=state.step, index=state.index,
+                    delta=state.delta, cutbacks=state.cutbacks, load_factor=state.load_factor,
+                    lam_previous=state.lam_previous, factors=list(map(float, state.factors)))
+        with open(os.path.join(path, "meta.json"), "w") as f:
+            json.dump(meta, f)
+            f.flush()
+            os.fsync(f.fileno())
+        tmp = os.path.join(directory, "LATEST.tmp")
+        with open(tmp, "w") as f:
+            f.write(slot)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, os.path.join(directory, "LATEST"))
+    comm.Barrier()
+
+
+def _latest(directory: str) -> Optional[str]:
+    try:
+        with open(os.path.join(directory, "LATEST")) as f:
+            return f.read().strip()
+    except FileNotFoundError:
+        return None
+
+
+def read_checkpoint(directory: str, problem, factors) -> CheckpointState:
+    """Restore the latest checkpoint of ``directory`` into ``problem`` (collective): the
+    displacement, the interface's committed state and dissipation, the load factor.
+
+    Raises:
+        CheckpointError: see the module.
+    """
+    comm = problem.comm
+    slot = _latest(directory) if comm.rank == 0 else None
+    slot = comm.bcast(slot, root=0)
+    if slot is None:
+        raise CheckpointError(f"restart directory {directory!r} holds no checkpoint (no LATEST "
+                              "file): nothing to resume")
+    path = os.path.join(directory, slot)
+    meta = None
+    if comm.rank == 0:
+        with open(os.path.join(path, "meta.json")) as f:
+            meta = json.load(f)
+    meta = comm.bcast(meta, root=0)
+    mine = signature(problem)
+    saved = meta["signature"]
+    diff = [f"{k}: checkpoint {saved[k]!r}, this problem {mine[k]!r}" for k in saved
+            if (saved[k] != mine[k] if k != "dof_checksum"
+                else not np.isclose(saved[k], mine[k], rtol=1e-12, atol=1e-9))]
+    if diff:
+        raise CheckpointError(f"restart directory {directory!r} was written by another problem "
+                              f"(mesh, partition or law differ): {'; '.join(diff)}")
+    factors = [float(f) for f in factors]
+    if factors != meta["factors"]:
+        raise CheckpointError(f"the load factors given ({len(factors)}) differ from those of the "
+                              f"checkpointed run ({len(meta['factors'])}): resume with the same "
+                              "load path")
+    with open(os.path.join(path, f"rank{comm.rank}.pkl"), "rb") as f:
+        data = pickle.load(f)
+    if data["u"].shape != problem.u.x.array.shape:
+        raise CheckpointError(f"rank {comm.rank}: {data['u'].shape[0]} local DOFs in the "
+                              f"checkpoint, {problem.u.x.array.shape[0]} in this problem")
+    problem.u.x.array[:] = data["u"]
+    problem.u.x.scatter_forward()
+    problem.set_load_factor(meta["load_factor"])
+    ci = problem.interface
+    if ci is not None:
+        ci.history.restore(data["committed"], data["dissipated"])
+        ci.revert()
+    return CheckpointState(step=meta["step"], index=meta["index"], delta=meta["delta"],
+                           cutbacks=meta["cutbacks"], load_factor=meta["load_factor"],
+                           lam_previous=meta["lam_previous"], u_previous=data["u_previous"],
+                           factors=factors)
