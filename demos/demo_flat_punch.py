@@ -68,6 +68,11 @@ def parse_args(argv):
                         help="asperity population of the normal law (elasto-plastic: Y, psi, ch, "
                         "omega_p/omega_c of Figs 18-19)")
     parser.add_argument("--outdir", default="results/flat_punch")
+    parser.add_argument("--checkpoint", default=None, metavar="DIR",
+                        help="write a checkpoint after every converged increment into DIR")
+    parser.add_argument("--restart", default=None, metavar="DIR",
+                        help="continue a stopped run from its checkpoint DIR (same options and "
+                             "number of ranks)")
     parser.add_argument("--validity", default="warn", choices=["warn", "error", "ignore"],
                         help="interface points beyond the normal law's validity in a converged "
                              "increment: warn (default), stop with an error, or only count them")
@@ -104,5 +109,6 @@ if __name__ == "__main__":
     run(mesh_size=args.mesh_size, contact_size=args.contact_size, order=args.order,
         load_half_width=args.load_half_width, steps=args.steps, unload=not args.no_unload,
         law=args.law, case=args.case, normal_law=args.normal_law, outdir=args.outdir,
-        dof_threshold=args.dof_threshold, overwrite=True, validity=args.validity)
+        dof_threshold=args.dof_threshold, overwrite=True, validity=args.validity,
+        checkpoint=args.checkpoint, restart=args.restart)
 

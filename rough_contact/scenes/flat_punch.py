@@ -290,12 +290,16 @@ def plot_slip_directions(comm, interface, path, title, n_grid=12):
 def run(mesh_size=20.0, contact_size=2.0, order=2, load_half_width=2.5, steps=16,
          unload=True, law="rough", case="b", normal_law="elasto-plastic", outdir="results/flat_punch",
          prefix="rc_", dof_threshold=None, comm=MPI.COMM_WORLD, verbose=True, plot=True,
-         overwrite=False, validity="warn"):
+         overwrite=False, validity="warn", checkpoint=None, restart=None):
     """Run the punch; return a dict of results (identical on every rank). Collective.
 
     ``outdir`` receives one run: earlier results there make it refuse unless ``overwrite``.
     ``validity``: what a converged increment with interface points beyond the normal law's
     validity does (``"warn"``, ``"error"``, ``"ignore"``; ``rough_contact.solver.loading``).
+    ``checkpoint``: directory receiving a checkpoint after every converged increment;
+    ``restart``: a checkpoint directory of the same run (same options and ranks) to continue
+    from (``rough_contact.solver.checkpoint``); the output folder then holds the increments of
+    the resumed part only.
     """
     t0 = MPI.Wtime()
     m = build(comm, mesh_size, contact_size, order, load_half_width, law, case, normal_law,
@@ -316,7 +320,8 @@ def run(mesh_size=20.0, contact_size=2.0, order=2, load_half_width=2.5, steps=16
                         comm=comm)
     history = []
     peak = None
-    for inc in load_path(problem, solver, factors, verbose=verbose, validity=validity):
+    for inc in load_path(problem, solver, factors, verbose=verbose, validity=validity,
+                         checkpoint=checkpoint, resume=restart):
         # Force balance: the normal interface force on the punch equals the applied load (its
         # tangential resultant is carried by the symmetry planes of the quarter model).
         err = abs(inc.contact_force[2] + inc.applied_force[2]) / abs(inc.applied_force[2])
@@ -327,6 +332,13 @@ def run(mesh_size=20.0, contact_size=2.0, order=2, load_half_width=2.5, steps=16
             if plot:
                 plot_slip_directions(comm, interface, os.path.join(outdir, "slip_directions_peak.png"),
                                      f"plastic slip directions at 1000 N (case {case})")
+    if not history:                      # restarted from the checkpoint of a completed run
+        D = interface.dissipation()
+        PETSc.Sys.Print(f"Nothing left to do: the checkpoint in {restart} is the end of the run; "
+                        f"total frictional dissipation D: {D:.4g} N mm", comm=comm)
+        solver.destroy()
+        return dict(dissipation=D, history=history, peak=None, num_dofs=problem.num_dofs,
+                    n_points=n_points, max_force_error=0.0)
     if plot:
         plot_slip_directions(comm, interface, os.path.join(outdir, "slip_directions.png"),
                              f"plastic slip directions after unloading (case {case})")

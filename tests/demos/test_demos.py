@@ -144,3 +144,36 @@ def test_demo_fretting(tmp_path):
     k = [float(r["secant_stiffness_N_per_mm"]) for r in rows]
     assert abs(e[0]) < 1e-9 * e[1] and e[1] > 0 and k[1] < k[0]
     assert (tmp_path / "fret" / "fretting.png").exists()
+
+
+def test_demo_flat_punch_restart(tmp_path):
+    """A run stopped after its first increment (checkpoint written by the library, as a killed
+    demo leaves it) and continued with ``--restart`` ends with the dissipation of the
+    uninterrupted run; the restarted output holds the remaining increments only; restarting
+    from the checkpoint of a finished run has nothing left to do."""
+    import re
+
+    full = run([DEMOS / "demo_flat_punch.py", *PUNCH_SMALL, "--outdir", tmp_path / "full"],
+               tmp_path)
+    script = tmp_path / "partial.py"
+    script.write_text(
+        "from mpi4py import MPI\n"
+        "from rough_contact.scenes import flat_punch\n"
+        "from rough_contact.solver.loading import load_path, load_unload_factors\n"
+        "m = flat_punch.build(MPI.COMM_WORLD, 20.0, 5.0, 1, 2.5, 'rough', 'b', 'elastic', 2,\n"
+        "                     'rc_', None)\n"
+        "for inc in load_path(m.problem, m.solver, load_unload_factors(2, 1),\n"
+        f"                     checkpoint={str(tmp_path / 'ckpt')!r}):\n"
+        "    break                                   # stopped after the first increment\n")
+    run([script], tmp_path)
+    resumed = run([DEMOS / "demo_flat_punch.py", *PUNCH_SMALL, "--outdir", tmp_path / "rest",
+                   "--restart", tmp_path / "ckpt", "--checkpoint", tmp_path / "ckpt"], tmp_path)
+    pattern = r"Total frictional dissipation D .*?: ([0-9.eE+-]+) N mm"
+    assert re.search(pattern, resumed).group(1) == re.search(pattern, full).group(1)
+    with open(tmp_path / "rest" / "history.csv") as f:
+        assert len(f.read().strip().splitlines()) == 1 + 2       # header + increments 2 and 3
+    again = run([DEMOS / "demo_flat_punch.py", *PUNCH_SMALL, "--outdir", tmp_path / "again",
+                 "--restart", tmp_path / "ckpt"], tmp_path)   # the checkpoint is now the end
+    assert "Nothing left to do" in again
+    assert re.search(r"dissipation D: ([0-9.eE+-]+) N mm", again).group(1) == \
+        re.search(pattern, full).group(1)
