@@ -56,6 +56,7 @@ import dolfinx
 import dolfinx.cpp
 import dolfinx.fem
 from rough_contact.fem.collective import raise_on_all_ranks
+from rough_contact.fem.pairing import SecondSurface, project_points
 from rough_contact.fem.rigid import RigidPlane as RigidPlaneSurface
 from rough_contact.fem.rigid import RigidSurface
 from rough_contact.interface.contract import (
@@ -218,11 +219,23 @@ class ContactInterface:
         bcs: Dirichlet conditions whose DOFs the interface must not touch (also
             ``set_dirichlet_dofs``).
         match_tolerance: vertex matching tolerance relative to the facet size [-], > 0.
+        pairing: how the second surface is paired with the first one: ``"conforming"`` (facet
+            to facet, the surfaces must be the same surface mesh: exact node-to-node
+            kinematics), ``"projection"`` (every quadrature point projected along the first
+            normal onto the second surface's facets: non-matching meshes, see
+            :mod:`rough_contact.fem.pairing`) or ``"auto"`` (default: conforming if every
+            facet finds its match, else projection; ``pairing_used`` tells which).
+        search_radius: for projection: the largest accepted distance between a first-surface
+            point and its partner along the normal [mm], > 0; default: the largest facet
+            diameter of the first surface. Points without partner within it are an error.
 
     Attributes:
         history: committed and trial law state and the accumulated dissipation
             (:class:`~rough_contact.interface.state.StatePair`).
         n_points, n_points_global: interface quadrature points on this rank / on all ranks.
+        pairing_used: ``"conforming"``, ``"projection"`` or ``"rigid"``.
+        n_groups: pairs of (first facet, partner facet) on this rank: the element blocks
+            assembled (= n_facets for conforming pairs and rigid obstacles).
 
     Raises:
         TypeError: ``law`` does not satisfy the protocol (names the missing methods).
@@ -245,6 +258,8 @@ class ContactInterface:
         quadrature: str = "gauss",
         bcs: Sequence[dolfinx.fem.DirichletBCMetaClass] = (),
         match_tolerance: float = 1e-6,
+        pairing: str = "auto",
+        search_radius: Optional[float] = None,
     ):
         self.comm = V.mesh.comm
         self.V = V
@@ -263,6 +278,11 @@ class ContactInterface:
         grain, degree = _check_arguments(V, law, first_tag, second_tag, rigid_plane,
                                          quadrature_degree, grain_direction, match_tolerance,
                                          quadrature)
+        if pairing not in ("auto", "conforming", "projection"):
+            raise ValueError(f"pairing = {pairing!r} is invalid: it must be 'auto', "
+                             "'conforming' or 'projection'")
+        if search_radius is not None:
+            check_scalar("search_radius", search_radius, lo=0.0, unit="mm")
         self.first_tag, self.second_tag = first_tag, second_tag
         n_owned_facets = _facet_connectivity(V.mesh)
         rule = _FacetRule.create(V.mesh, degree, vertex=quadrature == "vertex")
@@ -272,12 +292,20 @@ class ContactInterface:
         xq, normal, N1 = self._first_surface(geo1, rule)
         R = self._local_axes(xq, normal, grain, rigid)
         if second_tag is None:
-            N2 = nodes2 = None
+            paired = None
             self.n_remote_partners = 0
+            self.pairing_used = "rigid"
         else:
-            N2, nodes2 = self._pair_second_surface(facet_tags, second_tag, n_owned_facets, geo1,
-                                                   rule, match_tolerance)
-        self._jump_operator(R, N1, geo1.global_nodes, N2, nodes2)
+            paired = None
+            if pairing != "projection":
+                paired = self._pair_second_surface(facet_tags, second_tag, n_owned_facets, geo1,
+                                                   rule, match_tolerance,
+                                                   strict=pairing == "conforming")
+            self.pairing_used = "conforming" if paired is not None else "projection"
+            if paired is None:
+                paired = self._project_second_surface(facet_tags, second_tag, n_owned_facets,
+                                                      geo1, xq, R, search_radius)
+        self._jump_operator(R, N1, geo1.global_nodes, paired)
         self._communication(bcs)
         self.history = self._initial_history()
         self._last_u = self._last = self._last_jump = None
@@ -346,12 +374,16 @@ class ContactInterface:
         return R
 
     def _pair_second_surface(self, facet_tags, second_tag: int, n_owned_facets: int,
-                             geo1: _FacetGeometry, rule: _FacetRule, match_tolerance: float):
-        """Partner facets on the second surface, from an all-gathered copy of it (collective).
+                             geo1: _FacetGeometry, rule: _FacetRule, match_tolerance: float,
+                             strict: bool = True) -> Optional[_Partners]:
+        """Conforming partner facets on the second surface, from an all-gathered copy of it
+        (collective).
 
         Returns:
-            N2: (n_f, nq, n_close) partner basis values at the points of the first facets.
-            nodes2: (n_f, n_close) global block indices of the partner's closure DOFs.
+            The partners, or None if some facet has no match and ``strict`` is False.
+
+        Raises:
+            ValueError: some facet has no match and ``strict`` is True.
         """
         comm = self.comm
         n_f, nq, nv = geo1.facets.size, rule.nq, rule.lam.shape[1]
@@ -381,6 +413,8 @@ class ContactInterface:
                 np.sort(perm, axis=1) == np.arange(nv)
             ).all(axis=1)
         n_bad = comm.allreduce(int(np.sum(~ok)), op=MPI.SUM)
+        if n_bad and not strict:
+            return None
         if n_bad:
             example = comm.allgather(vx1[~ok].mean(axis=1)[0].tolist() if np.any(~ok) else None)
             example = next(e for e in example if e is not None)
@@ -404,31 +438,163 @@ class ContactInterface:
         )
         closure2 = geo1.closure[lf2]  # same element on both sides
         N2 = np.take_along_axis(phi2, closure2[:, None, :], axis=2)
-        return N2, nodes2_all[partner]
+        shape = (n_f, nq)
+        return _Partners(
+            N2=N2, nodes2=np.broadcast_to(nodes2_all[partner][:, None, :], shape + (n_close,)),
+            facet=np.broadcast_to(partner[:, None], shape),
+            remote=np.broadcast_to((owner2[partner] != comm.rank)[:, None], shape),
+            gap0=np.zeros(shape))
+
+    def _project_second_surface(self, facet_tags, second_tag: int, n_owned_facets: int,
+                                geo1: _FacetGeometry, xq: np.ndarray, R: np.ndarray,
+                                search_radius: Optional[float]) -> _Partners:
+        """Non-matching partners: every point projected along its normal onto an all-gathered
+        copy of the second surface (:func:`rough_contact.fem.pairing.project_points`;
+        collective).
+
+        Raises:
+            ValueError (on every rank): points without partner within the search radius, or
+                whose only candidates face the wrong way (count, first coordinates, the
+                nearest distance found).
+        """
+        comm = self.comm
+        msh = self.V.mesh
+        n_f, nq = xq.shape[:2]
+        element = self.V.element.basix_element
+        cell = _basix_cell(msh)
+        ref_facets = np.array(basix.topology(cell)[2])
+        ref_x = np.asarray(basix.geometry(cell), dtype=float)
+        ref_normals = basix.cell.facet_outward_normals(cell)
+        geo2 = _FacetGeometry(self.V, _owned_tagged_facets(facet_tags, second_tag,
+                                                           n_owned_facets, comm))
+        n_close = geo2.closure.shape[1]
+        gathered = comm.allgather((geo2.cell_nodes_x, geo2.local_facet, geo2.global_nodes,
+                                   geo2.vertex_x))
+        owner2 = np.concatenate(
+            [np.full(g[1].size, r, dtype=np.int64) for r, g in enumerate(gathered)])
+        cell_x = np.concatenate([g[0] for g in gathered])
+        lf2_all = np.concatenate([g[1] for g in gathered]).astype(np.int64)
+        nodes2_all = np.concatenate([g[2] for g in gathered]).reshape(-1, n_close)
+        vx2 = np.concatenate([g[3] for g in gathered])
+        fv = ref_x[ref_facets[lf2_all]]  # (n2, nv, 3)
+        surface = SecondSurface(
+            cell_x=cell_x, v0=fv[:, 0], tangents=np.stack([fv[:, 1] - fv[:, 0],
+                                                           fv[:, 2] - fv[:, 0]], axis=2),
+            ref_normal=ref_normals[lf2_all], triangle=ref_facets.shape[1] == 3,
+            centroid=vx2.mean(axis=1))
+        if search_radius is None:
+            vx1 = geo1.vertex_x
+            diam = (np.linalg.norm(vx1[:, :, None] - vx1[:, None], axis=-1).max(initial=0.0)
+                    if n_f else 0.0)
+            search_radius = comm.allreduce(float(diam), op=MPI.MAX)
+        x = xq.reshape(-1, 3)
+        normal = R[..., 0, :].reshape(-1, 3)
+        proj = project_points(x, normal, surface, _cmap_element(msh), search_radius)
+        missing = proj.facet < 0
+        n_missing = comm.allreduce(int(missing.sum()), op=MPI.SUM)
+        if n_missing:
+            n_facing = comm.allreduce(int(proj.facing_failure.sum()), op=MPI.SUM)
+            first = comm.allgather(x[missing][:3].tolist() if missing.any() else [])
+            first = [p for r in first for p in r][:3]
+            nearest = comm.allreduce(float(proj.nearest[missing].min(initial=np.inf)),
+                                     op=MPI.MIN)
+            n_total = comm.allreduce(x.shape[0], op=MPI.SUM)
+            why = (f"{n_facing} of them only found facets of surface {second_tag} that face the "
+                   "same way (the surfaces must face each other: check the tags and the "
+                   "bodies they belong to); " if n_facing else "")
+            found = (f"the nearest partner found along the normal of such a point is "
+                     f"{nearest:.6g} mm away" if np.isfinite(nearest) else
+                     "no facet of the second surface lies on their normals")
+            raise ValueError(
+                f"{n_missing} of {n_total} quadrature points of contact surface "
+                f"{self.first_tag} have no partner on surface {second_tag} within the search "
+                f"radius {search_radius:.6g} mm along their normal; {why}{found}; first "
+                f"points: {first}. Check that the surfaces overlap and face each other, or "
+                "raise search_radius")
+        lf2 = lf2_all[proj.facet]
+        phi2 = (element.tabulate(0, proj.X_ref)[0].reshape(x.shape[0], element.dim)
+                if x.shape[0] else np.zeros((0, element.dim)))
+        N2 = np.take_along_axis(phi2, geo2.closure[lf2], axis=1)
+        shape = (n_f, nq)
+        self.n_remote_partners = int(np.sum(owner2[proj.facet] != comm.rank))
+        return _Partners(N2=N2.reshape(shape + (n_close,)),
+                         nodes2=nodes2_all[proj.facet].reshape(shape + (n_close,)),
+                         facet=proj.facet.reshape(shape),
+                         remote=(owner2[proj.facet] != comm.rank).reshape(shape),
+                         gap0=proj.distance.reshape(shape))
 
     def _jump_operator(self, R: np.ndarray, N1: np.ndarray, nodes1: np.ndarray,
-                       N2: Optional[np.ndarray], nodes2: Optional[np.ndarray]) -> None:
-        """B per point: jump = B u_pair + jump0 in local axes, columns in ascending global DOF
-        order (PETSc inserts sorted columns faster), plus the per-facet views used by matmul."""
+                       partners: Optional[_Partners]) -> None:
+        """B per point: jump = B u_pair + jump0 in local axes.
+
+        Points are grouped into element blocks ("groups"): one per (first facet, partner facet)
+        pair, holding the first facet's points whose partner lies on that facet (all the
+        facet's points for conforming pairs and rigid obstacles, so a group is a facet). A
+        group's columns are the closure DOFs of both facets in ascending global order (PETSc
+        inserts sorted columns faster); it has ``nqs`` point slots, unused ones (fewer points
+        than slots) have B = 0 and take no weight. ``_point_slot`` maps each point to its slot.
+        """
         n_f, nq, n_close = N1.shape
-        B = -np.einsum("fqac,fqk->fqakc", R, N1).reshape(n_f, nq, 3, 3 * n_close)
-        nodes = nodes1  # (n_f, n_close)
-        if N2 is not None:
-            B2 = np.einsum("fqac,fqk->fqakc", R, N2).reshape(n_f, nq, 3, 3 * n_close)
-            B = np.concatenate([B, B2], axis=3)
-            nodes = np.concatenate([nodes, nodes2], axis=1)
-        pair_dofs = (3 * nodes[:, :, None] + np.arange(3)).reshape(n_f, 3 * nodes.shape[1])
+        B1 = -np.einsum("fqac,fqk->fqakc", R, N1).reshape(n_f, nq, 3, 3 * n_close)
+        if partners is None:
+            groups_of_facet = np.arange(n_f)
+            group_facet = np.arange(n_f)
+            slot = np.tile(np.arange(nq), n_f)
+            nqs, n_g = nq, n_f
+            B = B1
+            nodes = nodes1
+        else:
+            if partners.facet.size:
+                key = np.arange(n_f)[:, None] * (int(partners.facet.max()) + 1) + partners.facet
+            else:
+                key = np.zeros((0, nq), dtype=np.int64)
+            uniq, group = np.unique(key.ravel(), return_inverse=True)
+            n_g = uniq.size
+            order = np.argsort(group, kind="stable")
+            counts = np.bincount(group, minlength=n_g)
+            starts = (np.cumsum(counts) - counts).astype(np.int64)
+            slot = np.empty(group.size, dtype=np.int64)
+            slot[order] = np.arange(group.size) - np.repeat(starts, counts)
+            nqs = int(counts.max(initial=0))
+            first_point = order[starts] if n_g else np.zeros(0, dtype=np.int64)
+            group_facet = first_point // nq
+            B2 = np.einsum("fqac,fqk->fqakc", R, partners.N2).reshape(n_f * nq, 3, 3 * n_close)
+            B = np.zeros((n_g, nqs, 3, 6 * n_close))
+            B[group, slot] = np.concatenate([B1.reshape(n_f * nq, 3, 3 * n_close), B2],
+                                            axis=2)
+            nodes = np.concatenate([nodes1[group_facet],
+                                    partners.nodes2.reshape(n_f * nq, n_close)[first_point]],
+                                   axis=1)
+            self._jump0[:, 0] += partners.gap0.reshape(-1)
+            self.n_remote_partners = int(np.sum(partners.remote.reshape(-1)[first_point]))
+            groups_of_facet = group
+        point_slot = (groups_of_facet if partners is not None else np.repeat(groups_of_facet, nq)
+                      ) * nqs + slot
+        pair_dofs = (3 * nodes[:, :, None] + np.arange(3)).reshape(n_g, 3 * nodes.shape[1])
         order = np.argsort(pair_dofs, axis=1)
         pair_dofs = np.take_along_axis(pair_dofs, order, axis=1)
         B = np.take_along_axis(B, order[:, None, None, :], axis=3)
         self._n_pair_dofs = B.shape[3]
-        self._B = B.reshape(n_f * nq, 3, self._n_pair_dofs)
-        self._Bf = B.reshape(n_f, nq * 3, self._n_pair_dofs)  # per-facet view for matmul
+        self.n_groups, self._nqs = n_g, nqs
+        self._B = B.reshape(n_g * nqs, 3, self._n_pair_dofs)
+        self._Bf = B.reshape(n_g, nqs * 3, self._n_pair_dofs)  # per-group view for matmul
         self._BfT = np.ascontiguousarray(np.swapaxes(self._Bf, 1, 2))
-        self._pair_nodes = nodes  # (n_f, n_nodes_pair) global block indices
-        self._pair_dofs = pair_dofs  # (n_f, nd) global scalar DOFs
+        self._point_slot = point_slot.astype(np.int64)
+        self._identity_slots = bool(n_g * nqs == n_f * nq and
+                                    np.array_equal(point_slot, np.arange(n_f * nq)))
+        self._pair_nodes = nodes  # (n_g, n_nodes_pair) global block indices
+        self._pair_dofs = pair_dofs  # (n_g, nd) global scalar DOFs
         self.n_points = n_f * nq
         self.n_points_global = self.comm.allreduce(self.n_points, op=MPI.SUM)
+
+    def _to_slots(self, values: np.ndarray) -> np.ndarray:
+        """Per-point values (n_pts, ...) laid out in group slots (n_g * nqs, ...), zero in unused
+        slots."""
+        if self._identity_slots:
+            return values
+        out = np.zeros((self.n_groups * self._nqs,) + values.shape[1:])
+        out[self._point_slot] = values
+        return out
 
     def _communication(self, bcs) -> None:
         """One scatter for every DOF the owned facets touch; Dirichlet rows masked (collective)."""
@@ -497,11 +663,12 @@ class ContactInterface:
         """Global node-level (block size 3) (rows, cols) of every pair's dense block.
 
         Returns:
-            rows, cols: int64 arrays (n_facets, m, m) of global block indices, m = nodes per pair.
+            rows, cols: int64 arrays (n_groups, m, m) of global block indices, m = nodes per
+            group.
         """
         m = self._pair_nodes.shape[1]
-        rows = np.broadcast_to(self._pair_nodes[:, :, None], (self.n_facets, m, m))
-        cols = np.broadcast_to(self._pair_nodes[:, None, :], (self.n_facets, m, m))
+        rows = np.broadcast_to(self._pair_nodes[:, :, None], (self.n_groups, m, m))
+        cols = np.broadcast_to(self._pair_nodes[:, None, :], (self.n_groups, m, m))
         return rows, cols
 
     def create_matrix(self, a) -> PETSc.Mat:
@@ -576,8 +743,11 @@ class ContactInterface:
         return self._jump_of(self._pair_values(u))
 
     def _jump_of(self, u_pair: np.ndarray) -> np.ndarray:
-        # batched matmul per facet: (n_f, nq*3, nd) @ (n_f, nd, 1)
-        return (self._Bf @ u_pair[:, :, None]).reshape(-1, 3) + self._jump0
+        # batched matmul per group: (n_g, nqs*3, nd) @ (n_g, nd, 1)
+        jump = (self._Bf @ u_pair[:, :, None]).reshape(-1, 3)
+        if not self._identity_slots:
+            jump = jump[self._point_slot]
+        return jump + self._jump0
 
     def evaluate(self, u: Union[dolfinx.fem.Function, PETSc.Vec]) -> LawResult:
         """Evaluate the law at u (collective); cached while u's pair values do not change.
@@ -629,8 +799,8 @@ class ContactInterface:
     def assemble_residual(self, u: Union[dolfinx.fem.Function, PETSc.Vec], b: PETSc.Vec) -> None:
         """Add int B^T t dA to b (global PETSc Vec of V's layout) and assemble b (collective)."""
         res = self.evaluate(u)
-        tw = (res.traction * self._weights[:, None]).reshape(self.n_facets, 3 * self.n_qp, 1)
-        r = self._BfT @ tw  # (n_f, nd, 1)
+        tw = self._to_slots(res.traction * self._weights[:, None])
+        r = self._BfT @ tw.reshape(self.n_groups, 3 * self._nqs, 1)  # (n_g, nd, 1)
         rows = self._rows.ravel()
         keep = rows >= 0
         if np.any(keep):
@@ -643,10 +813,11 @@ class ContactInterface:
         res = self.evaluate(u)
         A.assemblyBegin(PETSc.Mat.AssemblyType.FLUSH)
         A.assemblyEnd(PETSc.Mat.AssemblyType.FLUSH)
-        if self.n_facets == 0:  # setValuesRCV with zero rows dies with SIGFPE
+        if self.n_groups == 0:  # setValuesRCV with zero rows dies with SIGFPE
             return
-        DB = (res.tangent * self._weights[:, None, None]) @ self._B  # (n_pts, 3, nd)
-        K = self._BfT @ DB.reshape(self._Bf.shape)  # (n_f, nd, nd), batched BLAS
+        D = self._to_slots(res.tangent * self._weights[:, None, None])
+        DB = D @ self._B  # (n_g * nqs, 3, nd)
+        K = self._BfT @ DB.reshape(self._Bf.shape)  # (n_g, nd, nd), batched BLAS
         rows = self._rows
         A.setValuesRCV(rows, rows, K, addv=PETSc.InsertMode.ADD_VALUES)
 
@@ -830,6 +1001,25 @@ def _facet_connectivity(msh) -> int:
     msh.topology.create_connectivity(tdim - 1, tdim)
     msh.topology.create_connectivity(tdim, tdim - 1)
     return msh.topology.index_map(tdim - 1).size_local
+
+
+@dataclass(frozen=True)
+class _Partners:
+    """The second surface seen from every point of the first one (n_f facets x nq points).
+
+    Attributes:
+        N2: (n_f, nq, n_close) partner facet's closure basis values at the partner point.
+        nodes2: (n_f, nq, n_close) global block indices of the partner facet's closure DOFs.
+        facet: (n_f, nq) partner facet id (an index into the gathered second surface).
+        remote: (n_f, nq) bool: the partner facet is owned by another rank.
+        gap0: (n_f, nq) initial normal gap [mm] (0 for conforming pairs).
+    """
+
+    N2: np.ndarray
+    nodes2: np.ndarray
+    facet: np.ndarray
+    remote: np.ndarray
+    gap0: np.ndarray
 
 
 @dataclass(frozen=True)

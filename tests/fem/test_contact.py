@@ -328,7 +328,16 @@ def test_errors():
     with pytest.raises(ValueError, match="tag 42"):
         ContactInterface(V, tags, 42, UPPER_BOTTOM, law=law)
     with pytest.raises(ValueError, match="no matching facet"):  # top vs bottom: far apart
+        ContactInterface(V, tags, LOWER_TOP, UPPER_TOP, law=law, pairing="conforming")
+    # the same with the default pairing: the projection finds the upper top 0.5 mm away, facing
+    # the same way as the lower top: a wrong tag, said so
+    with pytest.raises(ValueError, match=r"24 of 24 quadrature points .* no partner .* face the "
+                       r"same way .* 0.5 mm away"):
         ContactInterface(V, tags, LOWER_TOP, UPPER_TOP, law=law)
+    with pytest.raises(ValueError, match="pairing = 'mortar' is invalid"):
+        ContactInterface(V, tags, LOWER_TOP, UPPER_BOTTOM, law=law, pairing="mortar")
+    with pytest.raises(ValueError, match="search_radius = -1.0 mm is invalid"):
+        ContactInterface(V, tags, LOWER_TOP, UPPER_BOTTOM, law=law, search_radius=-1.0)
     with pytest.raises(ValueError, match="grain_direction"):
         ContactInterface(V, tags, LOWER_TOP, UPPER_BOTTOM, law=law, grain_direction=(0, 0, 1))
     with pytest.raises(ValueError, match="quadrature_degree = 1.5 is invalid"):
@@ -455,30 +464,40 @@ def test_against_ufl_gmsh_block_on_plane(cell_type, order):
     assert A_ci.norm() <= 1e-12 * A_ufl.norm()
 
 
+def _partner_figures(c, split, degree, pairing):
+    msh, tags = two_blocks(c, n=(3, 2, 1), split=split)
+    V = fem.VectorFunctionSpace(msh, ("Lagrange", degree))
+    law = SoftplusPenalty(1e4, 1e-3, k_tangential=5e3, friction=0.2)
+    ci = ContactInterface(V, tags, LOWER_TOP, UPPER_BOTTOM, law=law, pairing=pairing)
+    assert ci.pairing_used == pairing
+    if split and c.size > 1:
+        # all partners live elsewhere (every group is a facet with its one partner)
+        assert ci.n_remote_partners == ci.n_facets == ci.n_groups
+    u = fem.Function(V)
+    interpolate_bodies(u, lambda x, up: smooth_field(x, up, 2e-3))
+    b = residual(ci, V, u)
+    mass = fem.form(ufl.inner(ufl.TrialFunction(V), ufl.TestFunction(V)) * ufl.dx)
+    A = ci.create_matrix(mass)
+    ci.assemble_jacobian(u, A)
+    A.assemble()
+    figs = np.concatenate([ci.contact_force(), [b.norm(), A.norm(), ci.real_contact_area()]])
+    if split:
+        assert fd_check(ci, V, u.vector.copy(), 1e-8, np.random.default_rng(9)) < 1e-6
+    return figs
+
+
+@pytest.mark.parametrize("pairing", ["conforming", "projection"])
 @pytest.mark.parametrize("degree", [1, 2])
-def test_partners_on_other_ranks(degree):
-    """Every partner facet owned by another rank (split partition) gives the serial figures."""
-    comm = MPI.COMM_WORLD
-    figs = []
-    for c, split in ((comm, True), (MPI.COMM_SELF, False)):
-        msh, tags = two_blocks(c, n=(3, 2, 1), split=split)
-        V = fem.VectorFunctionSpace(msh, ("Lagrange", degree))
-        law = SoftplusPenalty(1e4, 1e-3, k_tangential=5e3, friction=0.2)
-        ci = ContactInterface(V, tags, LOWER_TOP, UPPER_BOTTOM, law=law)
-        if c is comm and comm.size > 1:
-            assert ci.n_remote_partners == ci.n_facets  # all partners live elsewhere
-        u = fem.Function(V)
-        interpolate_bodies(u, lambda x, up: smooth_field(x, up, 2e-3))
-        b = residual(ci, V, u)
-        mass = fem.form(ufl.inner(ufl.TrialFunction(V), ufl.TestFunction(V)) * ufl.dx)
-        A = ci.create_matrix(mass)
-        ci.assemble_jacobian(u, A)
-        A.assemble()
-        figs.append(np.concatenate([ci.contact_force(), [b.norm(), A.norm(),
-                                                          ci.real_contact_area()]]))
-        if c is comm:
-            assert fd_check(ci, V, u.vector.copy(), 1e-8, np.random.default_rng(9)) < 1e-6
-    np.testing.assert_allclose(figs[0], figs[1], rtol=1e-10)
+def test_partners_on_other_ranks(degree, pairing):
+    """Every partner facet owned by another rank (split partition) gives the serial figures,
+    with conforming pairs and with projected (non-matching) pairs; the projected pairs give
+    the conforming figures on this conforming mesh (to the projection's Newton tolerance)."""
+    world = _partner_figures(MPI.COMM_WORLD, True, degree, pairing)
+    serial = _partner_figures(MPI.COMM_SELF, False, degree, pairing)
+    np.testing.assert_allclose(world, serial, rtol=1e-10)
+    if pairing == "projection":
+        conforming = _partner_figures(MPI.COMM_SELF, False, degree, "conforming")
+        np.testing.assert_allclose(serial, conforming, rtol=1e-10)
 
 
 def test_history_commit_revert_and_dissipation():

@@ -11,6 +11,10 @@ Labels (tags in brackets):
     "bottom" (14, z = -h1), "x0" (15), "x1" (16), "y0" (17), "y1" (18); the side groups
     hold the sides of both blocks.
 
+``separate_blocks``: the same two blocks meshed independently (the common face is not
+fragmented: each block has its own surface mesh on z = 0, with its own element size), the case
+of parts meshed separately; same labels as ``two_blocks``.
+
 ``block_on_plane``: one block [0, lx] x [0, ly] x [0, h] on the rigid plane z = 0
 (``contact_pair = (contact, None)``, ``rigid_plane = ((0, 0, 0), (0, 0, 1))``).
 Labels: "block" (1), "contact" (11, z = 0), "top" (13), "x0".."y1" (15-18).
@@ -26,7 +30,7 @@ from rough_contact.fem.mesh import (Scene, add_groups, build_scene, entity_cente
                                     set_transfinite_hexahedra, validate_cell_type,
                                     validate_order, validate_positive)
 
-__all__ = ["two_blocks", "block_on_plane", "indented_block"]
+__all__ = ["two_blocks", "separate_blocks", "block_on_plane", "indented_block"]
 
 
 def _side_groups(model, lx, ly, tol):
@@ -95,6 +99,85 @@ def two_blocks(lx: float = 1.0, ly: float = 1.0, h1: float = 1.0, h2: float = 1.
         contact_pair=("contact_upper", "contact_lower"),
         surface_owners={"contact_upper": "upper", "contact_lower": "lower"},
         dimensions=dict(lx=lx, ly=ly, h1=h1, h2=h2, mesh_size=mesh_size))
+
+
+def separate_blocks(lx: float = 1.0, ly: float = 1.0, h1: float = 1.0, h2: float = 1.0,
+                    size_lower: float = 0.25, size_upper: float = 0.35, order: int = 1,
+                    cell_type: str = "tetrahedron",
+                    comm: MPI.Comm = MPI.COMM_WORLD) -> Scene:
+    """Two stacked boxes meshed independently: non-matching surface meshes on z = 0.
+    Collective.
+
+    Args:
+        lx, ly: plan size of both blocks [mm].
+        h1, h2: heights of the lower and upper block [mm].
+        size_lower, size_upper: element size in each block [mm] (tetrahedra: target size;
+            hexahedra: each box edge split into ``ceil(length / size)`` elements, so that
+            e.g. sizes 1/3 and 1/9 give nested faces and 1/5 and 1/7 non-nested ones).
+        order: 1 or 2 (P1/P2 tetrahedra, Q1/Q2 27-node hexahedra).
+        cell_type: ``"tetrahedron"`` or ``"hexahedron"``.
+        comm: communicator of the mesh (gmsh runs on rank 0).
+
+    Returns:
+        The scene; ``contact_pair = (contact_upper, contact_lower)``.
+    """
+    validate_positive(lx=lx, ly=ly, h1=h1, h2=h2, size_lower=size_lower,
+                      size_upper=size_upper)
+    validate_order(order)
+    validate_cell_type(cell_type)
+    tol = 1e-6 * max(lx, ly, h1, h2)
+
+    def build(model):
+        import gmsh
+
+        lower = model.occ.addBox(0, 0, -h1, lx, ly, h1)
+        upper = model.occ.addBox(0, 0, 0, lx, ly, h2)
+        model.occ.synchronize()   # no fragment: two independent surface meshes on z = 0
+        add_groups(model, 3, {"upper": (1, [upper]), "lower": (2, [lower])})
+        faces = {v: [t for _, t in model.getBoundary([(3, v)], oriented=False)]
+                 for v in (lower, upper)}
+        tags, c = entity_centers(model, 2)
+        z = c[:, 2]
+        on_z0 = set(tags[np.abs(z) < tol].tolist())
+        add_groups(model, 2, {
+            "contact_upper": (11, [t for t in faces[upper] if t in on_z0]),
+            "contact_lower": (12, [t for t in faces[lower] if t in on_z0]),
+            "top": (13, tags[np.abs(z - h2) < tol]),
+            "bottom": (14, tags[np.abs(z + h1) < tol]),
+            **_side_groups(model, lx, ly, tol)})
+        for vol, size in ((lower, size_lower), (upper, size_upper)):
+            edges = model.getBoundary([(2, f) for f in faces[vol]], combined=False,
+                                      oriented=False)
+            curves = sorted({abs(t) for _, t in edges})
+            if cell_type == "hexahedron":
+                for curve in curves:
+                    a, b = model.getBoundary([(1, curve)], combined=False, oriented=False)
+                    length = np.linalg.norm(np.subtract(model.getValue(0, a[1], []),
+                                                        model.getValue(0, b[1], [])))
+                    model.mesh.setTransfiniteCurve(curve, 1 + max(1, int(np.ceil(
+                        length / size - 1e-9))))
+            else:
+                points = model.getBoundary([(3, vol)], recursive=True)
+                model.mesh.setSize(points, size)
+        if cell_type == "hexahedron":
+            for dim, surface in model.getEntities(2):
+                model.mesh.setTransfiniteSurface(surface)
+                model.mesh.setRecombine(dim, surface)
+            for _, volume in model.getEntities(3):
+                model.mesh.setTransfiniteVolume(volume)
+        else:
+            gmsh.option.setNumber("Mesh.MeshSizeMax", max(size_lower, size_upper))
+        model.mesh.generate(3)
+        if order == 2:
+            gmsh.option.setNumber("Mesh.SecondOrderIncomplete", 0)
+            model.mesh.setOrder(2)
+
+    return build_scene(
+        comm, "separate_blocks", build, split_body="upper",
+        contact_pair=("contact_upper", "contact_lower"),
+        surface_owners={"contact_upper": "upper", "contact_lower": "lower"},
+        dimensions=dict(lx=lx, ly=ly, h1=h1, h2=h2, size_lower=size_lower,
+                        size_upper=size_upper))
 
 
 def block_on_plane(lx: float = 1.0, ly: float = 1.0, h: float = 1.0,
