@@ -56,7 +56,8 @@ import dolfinx
 import dolfinx.cpp
 import dolfinx.fem
 from rough_contact.fem.collective import raise_on_all_ranks
-from rough_contact.fem.pairing import SecondSurface, project_points
+from rough_contact.fem.pairing import (SecondSurface, _newton_on_facets, cyclic_order,
+                                       mortar_points, project_points)
 from rough_contact.fem.rigid import RigidPlane as RigidPlaneSurface
 from rough_contact.fem.rigid import RigidSurface
 from rough_contact.interface.contract import (
@@ -278,9 +279,9 @@ class ContactInterface:
         grain, degree = _check_arguments(V, law, first_tag, second_tag, rigid_plane,
                                          quadrature_degree, grain_direction, match_tolerance,
                                          quadrature)
-        if pairing not in ("auto", "conforming", "projection"):
+        if pairing not in ("auto", "conforming", "projection", "mortar"):
             raise ValueError(f"pairing = {pairing!r} is invalid: it must be 'auto', "
-                             "'conforming' or 'projection'")
+                             "'conforming', 'projection' or 'mortar'")
         if search_radius is not None:
             check_scalar("search_radius", search_radius, lo=0.0, unit="mm")
         self.first_tag, self.second_tag = first_tag, second_tag
@@ -289,9 +290,20 @@ class ContactInterface:
         geo1 = _FacetGeometry(V, _owned_tagged_facets(facet_tags, first_tag, n_owned_facets,
                                                       self.comm))
         self._facets1 = geo1.facets
-        xq, normal, N1 = self._first_surface(geo1, rule)
+        if pairing == "mortar":
+            if second_tag is None or quadrature != "gauss":
+                raise ValueError("pairing = 'mortar' needs a second surface (second_tag) and "
+                                 "the Gauss rule (quadrature='gauss')")
+            xq, normal, N1, mortar = self._mortar_surface(facet_tags, second_tag,
+                                                          n_owned_facets, geo1, degree,
+                                                          search_radius)
+        else:
+            xq, normal, N1 = self._first_surface(geo1, rule)
         R = self._local_axes(xq, normal, grain, rigid)
-        if second_tag is None:
+        if pairing == "mortar":
+            paired = mortar
+            self.pairing_used = "mortar"
+        elif second_tag is None:
             paired = None
             self.n_remote_partners = 0
             self.pairing_used = "rigid"
@@ -461,27 +473,9 @@ class ContactInterface:
         msh = self.V.mesh
         n_f, nq = xq.shape[:2]
         element = self.V.element.basix_element
-        cell = _basix_cell(msh)
-        ref_facets = np.array(basix.topology(cell)[2])
-        ref_x = np.asarray(basix.geometry(cell), dtype=float)
-        ref_normals = basix.cell.facet_outward_normals(cell)
-        geo2 = _FacetGeometry(self.V, _owned_tagged_facets(facet_tags, second_tag,
-                                                           n_owned_facets, comm))
-        n_close = geo2.closure.shape[1]
-        gathered = comm.allgather((geo2.cell_nodes_x, geo2.local_facet, geo2.global_nodes,
-                                   geo2.vertex_x))
-        owner2 = np.concatenate(
-            [np.full(g[1].size, r, dtype=np.int64) for r, g in enumerate(gathered)])
-        cell_x = np.concatenate([g[0] for g in gathered])
-        lf2_all = np.concatenate([g[1] for g in gathered]).astype(np.int64)
-        nodes2_all = np.concatenate([g[2] for g in gathered]).reshape(-1, n_close)
-        vx2 = np.concatenate([g[3] for g in gathered])
-        fv = ref_x[ref_facets[lf2_all]]  # (n2, nv, 3)
-        surface = SecondSurface(
-            cell_x=cell_x, v0=fv[:, 0], tangents=np.stack([fv[:, 1] - fv[:, 0],
-                                                           fv[:, 2] - fv[:, 0]], axis=2),
-            ref_normal=ref_normals[lf2_all], triangle=ref_facets.shape[1] == 3,
-            centroid=vx2.mean(axis=1))
+        second = _GatheredSurface.create(self.V, facet_tags, second_tag, n_owned_facets)
+        surface, owner2, lf2_all = second.surface, second.owner, second.local_facet
+        nodes2_all, n_close, closure = second.nodes, second.nodes.shape[1], second.closure
         if search_radius is None:
             vx1 = geo1.vertex_x
             diam = (np.linalg.norm(vx1[:, :, None] - vx1[:, None], axis=-1).max(initial=0.0)
@@ -514,7 +508,7 @@ class ContactInterface:
         lf2 = lf2_all[proj.facet]
         phi2 = (element.tabulate(0, proj.X_ref)[0].reshape(x.shape[0], element.dim)
                 if x.shape[0] else np.zeros((0, element.dim)))
-        N2 = np.take_along_axis(phi2, geo2.closure[lf2], axis=1)
+        N2 = np.take_along_axis(phi2, closure[lf2], axis=1)
         shape = (n_f, nq)
         self.n_remote_partners = int(np.sum(owner2[proj.facet] != comm.rank))
         return _Partners(N2=N2.reshape(shape + (n_close,)),
@@ -522,6 +516,110 @@ class ContactInterface:
                          facet=proj.facet.reshape(shape),
                          remote=(owner2[proj.facet] != comm.rank).reshape(shape),
                          gap0=proj.distance.reshape(shape))
+
+    def _mortar_surface(self, facet_tags, second_tag: int, n_owned_facets: int,
+                        geo1: _FacetGeometry, degree: int, search_radius: Optional[float]):
+        """Segment-to-segment points: the first facets clipped by the second surface's facets
+        projected on their planes, a triangle rule of ``degree`` on every piece
+        (:func:`rough_contact.fem.pairing.mortar_points`; collective).
+
+        Every first facet gets the same number of point slots (the largest count on any
+        rank): a facet with fewer pieces repeats its first point with weight 0.
+
+        Returns:
+            xq (n_f, nq, 3), normal (n_f, nq, 3), N1 (n_f, nq, n_close), weights (n_f * nq,),
+            and the partners.
+
+        Raises:
+            ValueError (on every rank): a part of the first surface is not covered by the
+                second surface (uncovered area, facet count, first centroid).
+        """
+        comm = self.comm
+        msh = self.V.mesh
+        element = self.V.element.basix_element
+        cmap = _cmap_element(msh)
+        second = _GatheredSurface.create(self.V, facet_tags, second_tag, n_owned_facets)
+        first = _facet_set(msh, geo1.cell_nodes_x, geo1.local_facet, geo1.vertex_x)
+        facet_cell = _CELLS[msh.topology.cell_type][1]
+        pts, wts = basix.make_quadrature(basix.CellType.triangle, degree)
+        mp = mortar_points(first, geo1.vertex_x, second.surface, second.vertex_x, pts, wts)
+        n_f = geo1.facets.size
+        # coverage: every first facet's area must be matched by overlaps
+        vx = geo1.vertex_x[:, cyclic_order(geo1.vertex_x.shape[1])]
+        plane_n = np.cross(vx[:, 1] - vx[:, 0], vx[:, -1] - vx[:, 0]) if n_f else np.zeros((0, 3))
+        area = np.linalg.norm(plane_n, axis=1) * (0.5 if facet_cell == basix.CellType.triangle
+                                                  else 1.0)
+        covered = np.bincount(mp.facet1, weights=mp.weight, minlength=n_f)
+        gap_area = np.clip(area - covered, 0.0, None)
+        bad = gap_area > 1e-8 * area
+        n_bad = comm.allreduce(int(bad.sum()), op=MPI.SUM)
+        if n_bad:
+            lost = comm.allreduce(float(gap_area[bad].sum()), op=MPI.SUM)
+            total = comm.allreduce(float(area.sum()), op=MPI.SUM)
+            first_c = comm.allgather(vx[bad].mean(axis=1)[0].tolist() if bad.any() else None)
+            first_c = next(c for c in first_c if c is not None)
+            raise ValueError(
+                f"{n_bad} facets of contact surface {self.first_tag} are not fully covered by "
+                f"surface {second_tag}: {lost:.6g} of {total:.6g} mm^2 have no partner "
+                f"(first such facet centred at {first_c}); with pairing='mortar' the first "
+                "surface must lie within the second one (make the smaller surface the first)")
+        # points on the first facets: reference coordinates, normals, basis values
+        plane_n = plane_n / np.maximum(np.linalg.norm(plane_n, axis=1), 1e-300)[:, None]
+        X1, _, conv1, _, _ = _newton_on_facets(mp.x, plane_n[mp.facet1], first, mp.facet1, cmap)
+        order = np.argsort(mp.facet1, kind="stable")
+        counts = np.bincount(mp.facet1, minlength=n_f)
+        nq = comm.allreduce(int(counts.max(initial=1)), op=MPI.MAX)
+        starts = np.cumsum(counts) - counts
+        slot = np.arange(nq)[None, :]
+        take = order[np.minimum(starts[:, None] + slot, starts[:, None] + counts[:, None] - 1)]
+        real = slot < counts[:, None]                       # (n_f, nq)
+        take = take.reshape(-1) if n_f else np.zeros(0, dtype=np.int64)
+        X1 = X1[take]
+        weights = np.where(real.reshape(-1), mp.weight[take], 0.0)
+        lf1 = np.repeat(geo1.local_facet, nq)
+        cell_x = np.repeat(geo1.cell_nodes_x, nq, axis=0)
+        tab = cmap.tabulate(1, X1).reshape(4, X1.shape[0], -1)
+        xq = np.einsum("pk,pki->pi", tab[0], cell_x)
+        J = np.einsum("pki,pkd->pid", cell_x, np.moveaxis(tab[1:], 0, -1))
+        ref_normals = basix.cell.facet_outward_normals(_basix_cell(msh))
+        outward = np.linalg.solve(np.swapaxes(J, 1, 2), ref_normals[lf1][:, :, None])[..., 0] \
+            if X1.shape[0] else np.zeros((0, 3))
+        normal = outward / np.maximum(np.linalg.norm(outward, axis=1), 1e-300)[:, None]
+        phi = element.tabulate(0, X1)[0].reshape(X1.shape[0], element.dim) if X1.shape[0] \
+            else np.zeros((0, element.dim))
+        N1 = np.take_along_axis(phi, geo1.closure[lf1], axis=1)
+        # partner points on the second facets, along the first normal
+        f2 = mp.facet2[take]
+        X2, gap0, conv2, _, facing = _newton_on_facets(xq, normal, second.surface, f2, cmap)
+        if search_radius is None:
+            search_radius = comm.allreduce(float(np.sqrt(area.max(initial=0.0))), op=MPI.MAX)
+        failed = ~(conv1[take] & conv2 & facing)
+        far = ~failed & (np.abs(gap0) > search_radius)
+        n_failed, n_far = comm.allreduce(np.array([failed.sum(), far.sum()]), op=MPI.SUM)
+        if n_failed or n_far:
+            dist = comm.allreduce(float(np.abs(gap0[far]).max(initial=0.0)), op=MPI.MAX)
+            raise ValueError(
+                f"{n_failed + n_far} mortar points of contact surface {self.first_tag} have no "
+                f"partner on surface {second_tag}: {n_failed} whose partner facet faces the "
+                f"same way or cannot be reached along their normal, {n_far} farther than the "
+                f"search radius {search_radius:.6g} mm (up to {dist:.6g} mm); the surfaces "
+                "must face each other and touch (check the tags and the bodies they belong "
+                "to)")
+        phi2 = element.tabulate(0, X2)[0].reshape(X2.shape[0], element.dim) if X2.shape[0] \
+            else np.zeros((0, element.dim))
+        N2 = np.take_along_axis(phi2, second.closure[second.local_facet[f2]], axis=1)
+        shape = (n_f, nq)
+        self.n_facets, self.n_qp = n_f, nq
+        self._weights = weights
+        self._x = xq
+        n_close = N1.shape[1]
+        partners = _Partners(N2=N2.reshape(shape + (n_close,)),
+                             nodes2=second.nodes[f2].reshape(shape + (n_close,)),
+                             facet=f2.reshape(shape),
+                             remote=(second.owner[f2] != comm.rank).reshape(shape),
+                             gap0=gap0.reshape(shape))
+        return (xq.reshape(shape + (3,)), normal.reshape(shape + (3,)),
+                N1.reshape(shape + (n_close,)), partners)
 
     def _jump_operator(self, R: np.ndarray, N1: np.ndarray, nodes1: np.ndarray,
                        partners: Optional[_Partners]) -> None:
@@ -1001,6 +1099,57 @@ def _facet_connectivity(msh) -> int:
     msh.topology.create_connectivity(tdim - 1, tdim)
     msh.topology.create_connectivity(tdim, tdim - 1)
     return msh.topology.index_map(tdim - 1).size_local
+
+
+def _facet_set(msh, cell_x: np.ndarray, local_facet: np.ndarray,
+               vertex_x: np.ndarray) -> SecondSurface:
+    """Facets as a :class:`rough_contact.fem.pairing.SecondSurface` (geometry for Newton)."""
+    cell = _basix_cell(msh)
+    ref_facets = np.array(basix.topology(cell)[2])
+    ref_x = np.asarray(basix.geometry(cell), dtype=float)
+    fv = ref_x[ref_facets[np.asarray(local_facet, dtype=np.int64)]]  # (n, nv, 3)
+    return SecondSurface(
+        cell_x=cell_x, v0=fv[:, 0], tangents=np.stack([fv[:, 1] - fv[:, 0],
+                                                       fv[:, 2] - fv[:, 0]], axis=2),
+        ref_normal=basix.cell.facet_outward_normals(cell)[np.asarray(local_facet, np.int64)],
+        triangle=ref_facets.shape[1] == 3, centroid=vertex_x.mean(axis=1))
+
+
+@dataclass(frozen=True)
+class _GatheredSurface:
+    """The second contact surface, all-gathered on every rank (for non-matching pairing).
+
+    Attributes:
+        surface: its facet geometry (:class:`rough_contact.fem.pairing.SecondSurface`).
+        owner: (n2,) owning rank of each facet.
+        local_facet: (n2,) local facet index in its cell.
+        nodes: (n2, n_close) global block indices of each facet's closure DOFs.
+        vertex_x: (n2, nv, 3) vertex coordinates.
+        closure: (n_lf, n_close) closure DOFs of every local facet of the element.
+    """
+
+    surface: SecondSurface
+    owner: np.ndarray
+    local_facet: np.ndarray
+    nodes: np.ndarray
+    vertex_x: np.ndarray
+    closure: np.ndarray
+
+    @classmethod
+    def create(cls, V, facet_tags, tag: int, n_owned_facets: int) -> _GatheredSurface:
+        comm = V.mesh.comm
+        geo = _FacetGeometry(V, _owned_tagged_facets(facet_tags, tag, n_owned_facets, comm))
+        n_close = geo.closure.shape[1]
+        gathered = comm.allgather((geo.cell_nodes_x, geo.local_facet, geo.global_nodes,
+                                   geo.vertex_x))
+        owner = np.concatenate(
+            [np.full(g[1].size, r, dtype=np.int64) for r, g in enumerate(gathered)])
+        lf = np.concatenate([g[1] for g in gathered]).astype(np.int64)
+        vx = np.concatenate([g[3] for g in gathered])
+        return cls(surface=_facet_set(V.mesh, np.concatenate([g[0] for g in gathered]), lf, vx),
+                   owner=owner, local_facet=lf,
+                   nodes=np.concatenate([g[2] for g in gathered]).reshape(-1, n_close),
+                   vertex_x=vx, closure=geo.closure)
 
 
 @dataclass(frozen=True)

@@ -37,7 +37,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
-__all__ = ["SecondSurface", "Projection", "project_points"]
+__all__ = ["SecondSurface", "Projection", "project_points", "MortarPoints", "clip_convex",
+           "mortar_points", "cyclic_order"]
 
 
 @dataclass(frozen=True)
@@ -190,3 +191,167 @@ def _project(x, normal, surface, cmap, search_radius, n_candidates, inside_tol, 
     nearest = np.where(geometric, np.abs(t), np.inf).reshape(n, k).min(axis=1)
     facing_failure = (within & ~facing).reshape(n, k).any(axis=1) & ~has
     return Projection(facet, X_best, distance, nearest, facing_failure)
+
+
+# --------------------------------------------------------------------------------------------
+# segment-to-segment (mortar-style) integration
+# --------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class MortarPoints:
+    """Quadrature points on the intersections of first facets with projected second facets.
+
+    Attributes:
+        facet1: (m,) local index of the first facet (into the caller's first-facet arrays).
+        facet2: (m,) partner facet in the :class:`SecondSurface`.
+        x: (m, 3) points on the first facet's plane [mm].
+        weight: (m,) area weights [mm^2] (sum over a first facet = its area, for flat facets
+            entirely covered by the second surface).
+    """
+
+    facet1: np.ndarray
+    facet2: np.ndarray
+    x: np.ndarray
+    weight: np.ndarray
+
+
+def cyclic_order(n_vertices: int) -> np.ndarray:
+    """Reference vertex order -> cyclic order (quadrilaterals are numbered tensor-wise)."""
+    return np.array([0, 1, 2]) if n_vertices == 3 else np.array([0, 1, 3, 2])
+
+
+def clip_convex(subject: np.ndarray, n_subject: np.ndarray, clip: np.ndarray) -> tuple:
+    """Sutherland–Hodgman clipping of polygons by convex counter-clockwise polygons, 2D,
+    vectorised over m pairs.
+
+    Args:
+        subject: (m, V, 2) polygon vertices (cyclic; rows beyond ``n_subject`` ignored).
+        n_subject: (m,) vertex counts.
+        clip: (m, c, 2) convex clip polygons, counter-clockwise.
+
+    Returns:
+        (vertices (m, V', 2), counts (m,)) of the intersections (count < 3: empty).
+    """
+    poly, n = subject, n_subject.astype(np.int64)
+    m = poly.shape[0]
+    rows = np.arange(m)[:, None]
+    for e in range(clip.shape[1]):
+        a = clip[:, e]
+        b = clip[:, (e + 1) % clip.shape[1]]
+        V = poly.shape[1]
+        idx = np.arange(V)[None, :]
+        valid = idx < n[:, None]
+        nxt = np.where(idx + 1 < n[:, None], idx + 1, 0)
+        p, q = poly, poly[rows, nxt]
+        edge = (b - a)[:, None, :]
+
+        def side(z):
+            return edge[..., 0] * (z[..., 1] - a[:, None, 1]) - edge[..., 1] * (
+                z[..., 0] - a[:, None, 0])
+
+        sp, sq = side(p), side(q)
+        inp, inq = sp >= 0.0, sq >= 0.0
+        denom = np.where(sp - sq == 0.0, 1.0, sp - sq)
+        cross = p + (sp / denom)[..., None] * (q - p)
+        out = np.stack([cross, q], axis=2).reshape(m, 2 * V, 2)
+        keep = np.stack([valid & (inp != inq), valid & inq], axis=2).reshape(m, 2 * V)
+        order = np.argsort(~keep, axis=1, kind="stable")
+        n = keep.sum(axis=1)
+        width = max(int(n.max(initial=0)), 1)
+        poly = np.take_along_axis(out, order[:, :width, None], axis=1)
+    return poly, n
+
+
+def mortar_points(first: SecondSurface, first_vertices: np.ndarray, second: SecondSurface,
+                  second_vertices: np.ndarray, rule_points: np.ndarray,
+                  rule_weights: np.ndarray, min_fraction: float = 1e-10) -> MortarPoints:
+    """Quadrature points on the overlaps of first facets with the second surface's facets
+    projected on the first facets' planes (flat-facet mortar integration).
+
+    Each first facet's vertex plane gets an orthonormal frame; the candidate second facets
+    (centroid closer than the two facets' radii) are projected on it along its normal, clipped
+    by the first facet (convex), fan-triangulated, and each triangle gets ``rule_points``.
+
+    Args:
+        first, second: the two surfaces (``first`` only for its centroids).
+        first_vertices: (n1, nv, 3) vertex coordinates of the first facets (reference order).
+        second_vertices: (n2, nv, 3) same for the second facets.
+        rule_points, rule_weights: a triangle quadrature rule on the reference triangle
+            (weights summing to 1/2).
+        min_fraction: overlaps smaller than this fraction of the first facet's area are
+            dropped (facets touching along an edge or a corner).
+
+    Returns:
+        The :class:`MortarPoints`.
+    """
+    n1, nv = first_vertices.shape[:2]
+    empty = MortarPoints(np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros((0, 3)),
+                         np.zeros(0))
+    if n1 == 0 or second.size == 0:
+        return empty
+    cyc = cyclic_order(nv)
+    P1 = first_vertices[:, cyc]
+    P2 = second_vertices[:, cyc]
+    c1 = P1.mean(axis=1)
+    c2 = P2.mean(axis=1)
+    r1 = np.linalg.norm(P1 - c1[:, None], axis=2).max(axis=1)
+    r2 = np.linalg.norm(P2 - c2[:, None], axis=2).max(axis=1)
+    # candidate pairs: centroid distance <= r1 + max r2 (then filtered by r1 + r2)
+    tree = cKDTree(c2)
+    counts = tree.query_ball_point(c1, r1 + r2.max(), return_length=True)
+    k = int(min(max(int(np.max(counts)), 1), second.size))
+    dist, cand = tree.query(c1, k=k)
+    dist, cand = np.asarray(dist).reshape(n1, k), np.asarray(cand).reshape(n1, k)
+    ok = (cand < second.size)
+    ok[ok] &= dist[ok] <= (r1[:, None] + r2[np.where(ok, cand, 0)])[ok] * (1 + 1e-12)
+    i1, j = np.nonzero(ok)
+    i2 = cand[i1, j]
+    # frames on the first facets' planes
+    e1 = P1[:, 1] - P1[:, 0]
+    e1 /= np.linalg.norm(e1, axis=1)[:, None]
+    nrm = np.cross(P1[:, 1] - P1[:, 0], P1[:, -1] - P1[:, 0])
+    nrm /= np.linalg.norm(nrm, axis=1)[:, None]
+    e2 = np.cross(nrm, e1)
+    origin = P1[:, 0]
+
+    def to2d(X, f):
+        d = X - origin[f][:, None, :]
+        return np.stack([np.einsum("pvi,pi->pv", d, e1[f]), np.einsum("pvi,pi->pv", d, e2[f])],
+                        axis=-1)
+
+    clip = to2d(P1[i1], i1)      # counter-clockwise by construction of e2 = n x e1
+    subj = to2d(P2[i2], i1)
+    # the projected second facet may be clockwise: reverse it (orientation does not matter
+    # for clipping a polygon by a convex one, but the fan areas below are signed)
+    area2 = 0.5 * np.sum(subj[:, :, 0] * np.roll(subj[:, :, 1], -1, axis=1)
+                         - np.roll(subj[:, :, 0], -1, axis=1) * subj[:, :, 1], axis=1)
+    subj = np.where((area2 < 0)[:, None, None], subj[:, ::-1], subj)
+    poly, n = clip_convex(subj, np.full(i1.size, nv), clip)
+    # fan triangulation from vertex 0, rule points on every triangle
+    V = poly.shape[1]
+    # facet areas (triangles; parallelograms for the flat quadrilaterals this rule assumes)
+    area1 = np.linalg.norm(np.cross(P1[:, 1] - P1[:, 0], P1[:, -1] - P1[:, 0]), axis=1)
+    if nv == 3:
+        area1 *= 0.5
+    xs, ws, f1s, f2s = [], [], [], []
+    for t in range(1, V - 1):       # at most 6 triangles: a loop over fan positions only
+        has = n > t + 1
+        if not has.any():
+            break
+        a, b, c = poly[has, 0], poly[has, t], poly[has, t + 1]
+        ab, ac = b - a, c - a
+        det = ab[:, 0] * ac[:, 1] - ab[:, 1] * ac[:, 0]
+        pts2 = a[:, None] + rule_points[None, :, 0, None] * ab[:, None] + \
+            rule_points[None, :, 1, None] * ac[:, None]      # (h, nq, 2)
+        f = i1[has]
+        x3 = origin[f][:, None] + pts2[..., 0, None] * e1[f][:, None] + \
+            pts2[..., 1, None] * e2[f][:, None]
+        w = np.abs(det)[:, None] * rule_weights[None, :]
+        keep = np.abs(det) > 2.0 * min_fraction * area1[f]
+        xs.append(x3[keep].reshape(-1, 3))
+        ws.append(w[keep].ravel())
+        f1s.append(np.repeat(f[keep], rule_points.shape[0]))
+        f2s.append(np.repeat(i2[has][keep], rule_points.shape[0]))
+    if not xs:
+        return empty
+    return MortarPoints(np.concatenate(f1s).astype(np.int64), np.concatenate(f2s).astype(
+        np.int64), np.concatenate(xs), np.concatenate(ws))
