@@ -57,7 +57,7 @@ import dolfinx.cpp
 import dolfinx.fem
 from rough_contact.fem.collective import raise_on_all_ranks
 from rough_contact.fem.pairing import (SecondSurface, _newton_on_facets, cyclic_order,
-                                       mortar_points, project_points)
+                                       mortar_points, project_points, tabulate)
 from rough_contact.fem.rigid import RigidPlane as RigidPlaneSurface
 from rough_contact.fem.rigid import RigidSurface
 from rough_contact.interface.contract import (
@@ -506,8 +506,7 @@ class ContactInterface:
                 f"points: {first}. Check that the surfaces overlap and face each other, or "
                 "raise search_radius")
         lf2 = lf2_all[proj.facet]
-        phi2 = (element.tabulate(0, proj.X_ref)[0].reshape(x.shape[0], element.dim)
-                if x.shape[0] else np.zeros((0, element.dim)))
+        phi2 = tabulate(element, 0, proj.X_ref)[0]
         N2 = np.take_along_axis(phi2, closure[lf2], axis=1)
         shape = (n_f, nq)
         self.n_remote_partners = int(np.sum(owner2[proj.facet] != comm.rank))
@@ -578,15 +577,14 @@ class ContactInterface:
         weights = np.where(real.reshape(-1), mp.weight[take], 0.0)
         lf1 = np.repeat(geo1.local_facet, nq)
         cell_x = np.repeat(geo1.cell_nodes_x, nq, axis=0)
-        tab = cmap.tabulate(1, X1).reshape(4, X1.shape[0], -1)
+        tab = tabulate(cmap, 1, X1)
         xq = np.einsum("pk,pki->pi", tab[0], cell_x)
         J = np.einsum("pki,pkd->pid", cell_x, np.moveaxis(tab[1:], 0, -1))
         ref_normals = basix.cell.facet_outward_normals(_basix_cell(msh))
         outward = np.linalg.solve(np.swapaxes(J, 1, 2), ref_normals[lf1][:, :, None])[..., 0] \
             if X1.shape[0] else np.zeros((0, 3))
         normal = outward / np.maximum(np.linalg.norm(outward, axis=1), 1e-300)[:, None]
-        phi = element.tabulate(0, X1)[0].reshape(X1.shape[0], element.dim) if X1.shape[0] \
-            else np.zeros((0, element.dim))
+        phi = tabulate(element, 0, X1)[0]
         N1 = np.take_along_axis(phi, geo1.closure[lf1], axis=1)
         # partner points on the second facets, along the first normal
         f2 = mp.facet2[take]
@@ -605,8 +603,7 @@ class ContactInterface:
                 f"search radius {search_radius:.6g} mm (up to {dist:.6g} mm); the surfaces "
                 "must face each other and touch (check the tags and the bodies they belong "
                 "to)")
-        phi2 = element.tabulate(0, X2)[0].reshape(X2.shape[0], element.dim) if X2.shape[0] \
-            else np.zeros((0, element.dim))
+        phi2 = tabulate(element, 0, X2)[0]
         N2 = np.take_along_axis(phi2, second.closure[second.local_facet[f2]], axis=1)
         shape = (n_f, nq)
         self.n_facets, self.n_qp = n_f, nq

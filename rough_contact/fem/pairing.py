@@ -116,6 +116,15 @@ def project_points(x: np.ndarray, normal: np.ndarray, surface: SecondSurface, cm
     return _project(x, normal, surface, cmap, search_radius, n_candidates, inside_tol, max_iter)
 
 
+def tabulate(element, nderiv: int, X: np.ndarray) -> np.ndarray:
+    """``element.tabulate(nderiv, X)`` as (n_derivatives, m, dim); safe for m = 0 (basix
+    asserts on an empty point set)."""
+    n_der = 1 if nderiv == 0 else 4
+    if X.shape[0] == 0:
+        return np.zeros((n_der, 0, element.dim))
+    return element.tabulate(nderiv, X).reshape(n_der, X.shape[0], element.dim)
+
+
 def _newton_on_facets(xp, nrm, surface, c, cmap, max_iter=25, inside_tol=1e-8):
     """Solve X_c(xi) = xp + t nrm on facets c (vectorised over m = len(c) pairs).
 
@@ -132,7 +141,7 @@ def _newton_on_facets(xp, nrm, surface, c, cmap, max_iter=25, inside_tol=1e-8):
     converged = np.zeros(m, dtype=bool)
     for _ in range(max_iter):
         X_ref = v0 + np.einsum("pij,pj->pi", T, xi)
-        tab = cmap.tabulate(1, X_ref).reshape(4, m, -1)  # (4, m, n_gdof)
+        tab = tabulate(cmap, 1, X_ref)  # (4, m, n_gdof)
         dphi = np.moveaxis(tab[1:], 0, -1)  # (m, n_gdof, 3)
         X = np.einsum("pk,pki->pi", tab[0], Xn)
         dX = np.einsum("pki,pkd,pdj->pij", Xn, dphi, T)  # (m, 3, 2)
@@ -153,7 +162,7 @@ def _newton_on_facets(xp, nrm, surface, c, cmap, max_iter=25, inside_tol=1e-8):
     else:
         inside = ((xi >= -inside_tol) & (xi <= 1.0 + inside_tol)).all(axis=1)
     # outward normal of the facet's body at the point: J^-T N_ref
-    tab = cmap.tabulate(1, X_ref).reshape(4, m, -1)
+    tab = tabulate(cmap, 1, X_ref)
     Jc = np.einsum("pki,pkd->pid", Xn, np.moveaxis(tab[1:], 0, -1))
     ok = np.abs(np.linalg.det(Jc)) > 1e-300
     n2 = np.zeros((m, 3))

@@ -1,0 +1,216 @@
+"""Non-matching interfaces: two blocks meshed independently (``separate_blocks``).
+
+* Patch test (the reference: a uniform pressure must cross any interface exactly, since the
+  exact solution — uniform stress, linear displacements — lies in every body's FE space):
+  segment-to-segment integration (``pairing="mortar"``) transmits it to 1e-8 on element-size
+  ratios 5:7 and 1:3, either side first, P1/P2 tetrahedra and Q1/Q2 hexahedra, frictionless
+  and with Coulomb friction (no slip: the blocks have the same lateral strain). The Gauss-point
+  projection (``pairing="projection"``) is exact only when each first facet lies inside one
+  second facet (nested meshes, fine side first), checked too.
+* Rank independence (serial = 2 ranks to 1e-10) of residual, Jacobian, force and area at a
+  smooth non-uniform displacement, both non-matching pairings; finite-difference Jacobian.
+* Errors: surfaces that face the same way, surfaces far apart, invalid knobs.
+
+Run serial and in parallel:
+    .venv/bin/python -m pytest tests/fem/test_nonmatching.py
+    mpirun -n 2 .venv/bin/python -m pytest tests/fem/test_nonmatching.py
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import ufl
+from mpi4py import MPI
+from petsc4py import PETSc
+
+import dolfinx
+from dolfinx import fem
+from rough_contact.fem.contact import ContactInterface
+from rough_contact.fem.problem import ContactProblem, Material, SurfaceLoad
+from rough_contact.interface.penalty import LinearPenalty, SoftplusPenalty
+from rough_contact.scenes.meshes.blocks import separate_blocks
+from rough_contact.solver.snes import SNESSolver
+
+E, NU = 2.0e5, 0.25
+
+
+def roller(V, scene, name, comp):
+    facets = scene.facet_tags.find(scene.tag(name))
+    dofs = fem.locate_dofs_topological(V.sub(comp), 2, facets)
+    return fem.dirichletbc(PETSc.ScalarType(0.0), dofs, V.sub(comp))
+
+
+def patch(cell_type, order, size_lower, size_upper, first, pairing, law, E_lower,
+          p=80.0, comm=MPI.COMM_WORLD):
+    """Uniform pressure p on the top of two separately meshed blocks on rollers; returns the
+    largest pressure and shear errors (relative to p), the contact force and the interface."""
+    scene = separate_blocks(h1=1.0, h2=0.5, size_lower=size_lower, size_upper=size_upper,
+                            order=order, cell_type=cell_type, comm=comm)
+    V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", order))
+    bcs = [roller(V, scene, "x0", 0), roller(V, scene, "y0", 1), roller(V, scene, "bottom", 2)]
+    a, b = scene.contact_pair
+    if first == "lower":
+        a, b = b, a
+    ci = ContactInterface(V, scene.facet_tags, a, b, law=law, bcs=bcs,
+                          quadrature_degree=2 * order, pairing=pairing)
+    assert ci.pairing_used == pairing
+    mats = {scene.tag("upper"): Material(E, NU), scene.tag("lower"): Material(E_lower, NU)}
+    problem = ContactProblem(V, mats, bcs, [SurfaceLoad(scene.tag("top"), traction=[0, 0, -p])],
+                             cell_tags=scene.cell_tags, facet_tags=scene.facet_tags,
+                             interface=ci)
+    solver = SNESSolver(problem, prefix="test_nonmatching_")
+    problem.set_load_factor(1.0)
+    result = solver.solve()
+    assert result.converged
+    ci.evaluate(problem.u)
+    pf = ci.point_fields()
+    real = pf.weight > 0          # mortar facets repeat a point with weight 0 to fill slots
+    c = scene.mesh.comm
+    p_err = c.allreduce(float(np.max(np.abs(pf.pressure[real] - p), initial=0.0)), op=MPI.MAX)
+    s_err = c.allreduce(float(np.max(np.abs(pf.shear[real]), initial=0.0)), op=MPI.MAX)
+    slipping = c.allreduce(int(pf.slipping[real].sum()), op=MPI.SUM)
+    force = ci.contact_force()
+    summary = ci.summary()
+    solver.destroy()
+    return p_err / p, s_err / p, force, summary, slipping
+
+
+CASES = [  # cell type, order, lower size, upper size, first surface
+    ("tetrahedron", 1, 0.2, 0.28, "upper"),        # 5:7
+    ("tetrahedron", 2, 0.2, 0.28, "lower"),
+    ("tetrahedron", 1, 0.1, 0.3, "lower"),         # 1:3, fine side first
+    ("tetrahedron", 1, 0.3, 0.1, "lower"),         # 3:1, coarse side first
+    ("hexahedron", 1, 1 / 5, 1 / 7, "upper"),
+    ("hexahedron", 2, 1 / 5, 1 / 7, "lower"),
+    ("hexahedron", 1, 1 / 3, 1 / 9, "lower"),      # coarse first, nested
+]
+
+
+@pytest.mark.parametrize("case", CASES, ids=lambda c: f"{c[0][:3]}-P{c[1]}-"
+                         f"{c[2]:.3g}:{c[3]:.3g}-{c[4]}")
+def test_mortar_patch_frictionless(case):
+    """Uniform pressure crosses a non-matching interface exactly (different block stiffness:
+    the blocks slide laterally against each other, the law carries no shear)."""
+    p_err, s_err, force, summary, _ = patch(*case, "mortar", LinearPenalty(1e6), 0.5 * E)
+    assert p_err <= 1e-8
+    assert abs(force[2] / 80.0 - (1.0 if case[4] == "upper" else -1.0)) <= 1e-10
+    assert abs(summary.nominal_area - 1.0) <= 1e-10
+
+
+@pytest.mark.parametrize("case", [CASES[1], CASES[3], CASES[5]],
+                         ids=lambda c: f"{c[0][:3]}-P{c[1]}-{c[2]:.3g}:{c[3]:.3g}-{c[4]}")
+def test_mortar_patch_with_friction(case):
+    """Coulomb friction, same material both sides: uniform pressure, no shear, no slip."""
+    law = SoftplusPenalty(1e6, 1e-7, k_tangential=1e6, friction=0.3)
+    p_err, s_err, force, summary, slipping = patch(*case, "mortar", law, E)
+    assert p_err <= 1e-8
+    assert s_err <= 1e-8
+    assert slipping == 0
+
+
+def test_projection_patch_nested_is_exact():
+    """Gauss points of the fine side, each fine facet inside one coarse facet: exact."""
+    for order in (1, 2):
+        p_err, *_ = patch("hexahedron", order, 1 / 3, 1 / 9, "upper", "projection",
+                          LinearPenalty(1e6), 0.5 * E)
+        assert p_err <= 1e-8
+
+
+def _interpolate_bodies(u, scene):
+    """A smooth displacement, different on each body (a jump across the interface)."""
+    upper = scene.cell_tags.find(scene.tag("upper"))
+    lower = scene.cell_tags.find(scene.tag("lower"))
+    for cells, s in ((lower, 0.0), (upper, 1.0)):
+        u.interpolate(lambda x: 2e-3 * np.stack([
+            np.sin(2 * x[0] + 1) * np.cos(x[1]) + 0.5 * s * np.cos(3 * x[1]),
+            np.cos(x[0] - 2 * x[1]) - 0.3 * s * np.sin(x[0]),
+            np.sin(x[0] + x[1] + x[2]) - 0.8 * s * (1 + x[0] * x[1])]), cells=cells)
+    u.x.scatter_forward()
+
+
+def _figures(comm, pairing, order=2, fd=False):
+    scene = separate_blocks(h1=1.0, h2=0.5, size_lower=0.2, size_upper=0.28, order=order,
+                            comm=comm)
+    V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", order))
+    law = SoftplusPenalty(1e4, 1e-3, k_tangential=5e3, friction=0.2)
+    ci = ContactInterface(V, scene.facet_tags, *scene.contact_pair, law=law,
+                          quadrature_degree=2 * order, pairing=pairing)
+    u = fem.Function(V)
+    _interpolate_bodies(u, scene)
+    b = dolfinx.cpp.la.petsc.create_vector(V.dofmap.index_map, 3)
+    b.set(0.0)
+    ci.assemble_residual(u, b)
+    mass = fem.form(ufl.inner(ufl.TrialFunction(V), ufl.TestFunction(V)) * ufl.dx)
+    A = ci.create_matrix(mass)
+    ci.assemble_jacobian(u, A)
+    A.assemble()
+    figs = np.concatenate([ci.contact_force(), [b.norm(), A.norm(), ci.real_contact_area(),
+                                                ci.nominal_area()]])
+    fd_err = None
+    if fd:   # central differences of the residual along a random direction
+        rng = np.random.default_rng(3)
+        x = u.vector.copy()
+        d = x.duplicate()
+        r0, r1 = d.getOwnershipRange()
+        d.setArray(rng.uniform(-1, 1, 3 * V.dofmap.index_map.size_global)[r0:r1] * 1e-4)
+        Jd = b.duplicate()
+        A.mult(d, Jd)
+        eps = 1e-5
+        res = []
+        for sgn in (1.0, -1.0):
+            xs = x.copy()
+            xs.axpy(sgn * eps, d)
+            bs = b.duplicate()
+            bs.set(0.0)
+            ci.assemble_residual(xs, bs)
+            res.append(bs)
+        fd_vec = res[0].copy()
+        fd_vec.axpy(-1.0, res[1])
+        fd_vec.scale(0.5 / eps)
+        fd_vec.axpy(-1.0, Jd)
+        fd_err = fd_vec.norm() / Jd.norm()
+    A.destroy()
+    return figs, fd_err
+
+
+@pytest.mark.parametrize("pairing", ["projection", "mortar"])
+def test_rank_independent_and_jacobian(pairing):
+    """Non-uniform state with friction: the same figures on all ranks and on one; the assembled
+    Jacobian is the derivative of the assembled residual."""
+    world, fd_err = _figures(MPI.COMM_WORLD, pairing, fd=True)
+    serial, _ = _figures(MPI.COMM_SELF, pairing)
+    np.testing.assert_allclose(world, serial, rtol=1e-10)
+    assert abs(world[-1] - 1.0) <= 1e-10        # nominal area: the whole 1 x 1 face
+    assert fd_err < 1e-6
+
+
+def test_errors():
+    comm = MPI.COMM_WORLD
+    scene = separate_blocks(h1=1.0, h2=0.5, size_lower=0.5, size_upper=0.4, comm=comm)
+    V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", 1))
+    law = LinearPenalty(1.0)
+    top, lower = scene.tag("top"), scene.tag("contact_lower")
+    # the upper block's top faces up like the lower block's top: a wrong tag
+    with pytest.raises(ValueError, match=r"have no partner on surface .* within the search "
+                       r"radius"):
+        ContactInterface(V, scene.facet_tags, top, lower, law=law, pairing="projection")
+    with pytest.raises(ValueError, match=r"not fully covered by surface"):
+        ContactInterface(V, scene.facet_tags, top, lower, law=law, pairing="mortar")
+    # the bottom of the lower block, 1 mm below its top, faces down: wrong way + far
+    bottom = scene.tag("bottom")
+    upper = scene.tag("contact_upper")
+    with pytest.raises(ValueError, match=r"no partner"):
+        ContactInterface(V, scene.facet_tags, upper, bottom, law=law, pairing="projection",
+                         search_radius=0.1)
+    with pytest.raises(ValueError, match="pairing = 'mortar' needs a second surface"):
+        ContactInterface(V, scene.facet_tags, upper, law=law, pairing="mortar",
+                         rigid_plane=((0, 0, 0), (0, 0, 1)))
+    with pytest.raises(ValueError, match="pairing = 'nts' is invalid"):
+        ContactInterface(V, scene.facet_tags, upper, lower, law=law, pairing="nts")
+    # a conforming pairing is refused on these meshes, with the conforming message
+    with pytest.raises(ValueError, match="must be conforming"):
+        ContactInterface(V, scene.facet_tags, upper, lower, law=law, pairing="conforming")
+    # auto falls back to the projection
+    ci = ContactInterface(V, scene.facet_tags, upper, lower, law=law)
+    assert ci.pairing_used == "projection"
