@@ -334,8 +334,8 @@ def test_errors():
     with pytest.raises(ValueError, match=r"24 of 24 quadrature points .* no partner .* face the "
                        r"same way .* 0.5 mm away"):
         ContactInterface(V, tags, LOWER_TOP, UPPER_TOP, law=law)
-    with pytest.raises(ValueError, match="pairing = 'mortar' is invalid"):
-        ContactInterface(V, tags, LOWER_TOP, UPPER_BOTTOM, law=law, pairing="mortar")
+    with pytest.raises(ValueError, match="pairing = 'segment' is invalid"):
+        ContactInterface(V, tags, LOWER_TOP, UPPER_BOTTOM, law=law, pairing="segment")
     with pytest.raises(ValueError, match="search_radius = -1.0 mm is invalid"):
         ContactInterface(V, tags, LOWER_TOP, UPPER_BOTTOM, law=law, search_radius=-1.0)
     with pytest.raises(ValueError, match="grain_direction"):
