@@ -83,7 +83,8 @@ class InterfaceSummary:
     committed one (summed over converged increments).
 
     Attributes:
-        n_points: number of interface quadrature points.
+        n_points: number of interface quadrature points (without the weight-0 copies that
+            fill the slots of the mortar pairing).
         n_contact: points with p > 0.
         n_slipping: points where the friction limit is active.
         contact_force: (3,) force on the FIRST body's surface in global axes [N].
@@ -614,7 +615,8 @@ class ContactInterface:
                              nodes2=second.nodes[f2].reshape(shape + (n_close,)),
                              facet=f2.reshape(shape),
                              remote=(second.owner[f2] != comm.rank).reshape(shape),
-                             gap0=gap0.reshape(shape))
+                             gap0=gap0.reshape(shape),
+                             copy_of=np.where(real, -1, np.arange(n_f)[:, None] * nq))
         return (xq.reshape(shape + (3,)), normal.reshape(shape + (3,)),
                 N1.reshape(shape + (n_close,)), partners)
 
@@ -627,7 +629,9 @@ class ContactInterface:
         facet's points for conforming pairs and rigid obstacles, so a group is a facet). A
         group's columns are the closure DOFs of both facets in ascending global order (PETSc
         inserts sorted columns faster); it has ``nqs`` point slots, unused ones (fewer points
-        than slots) have B = 0 and take no weight. ``_point_slot`` maps each point to its slot.
+        than slots) have B = 0 and take no weight. ``_point_slot`` maps each point to its slot;
+        a slot-filling copy (``partners.copy_of``, weight 0) shares the slot of the point it
+        repeats, so it costs nothing in the assembly.
         """
         n_f, nq, n_close = N1.shape
         B1 = -np.einsum("fqac,fqk->fqakc", R, N1).reshape(n_f, nq, 3, 3 * n_close)
@@ -643,7 +647,10 @@ class ContactInterface:
                 key = np.arange(n_f)[:, None] * (int(partners.facet.max()) + 1) + partners.facet
             else:
                 key = np.zeros((0, nq), dtype=np.int64)
-            uniq, group = np.unique(key.ravel(), return_inverse=True)
+            copy_of = (np.full(n_f * nq, -1, dtype=np.int64) if partners.copy_of is None
+                       else partners.copy_of.reshape(-1).astype(np.int64))
+            own = np.flatnonzero(copy_of < 0)          # points with a slot of their own
+            uniq, group = np.unique(key.ravel()[own], return_inverse=True)
             n_g = uniq.size
             order = np.argsort(group, kind="stable")
             counts = np.bincount(group, minlength=n_g)
@@ -651,20 +658,23 @@ class ContactInterface:
             slot = np.empty(group.size, dtype=np.int64)
             slot[order] = np.arange(group.size) - np.repeat(starts, counts)
             nqs = int(counts.max(initial=0))
-            first_point = order[starts] if n_g else np.zeros(0, dtype=np.int64)
+            first_point = own[order[starts]] if n_g else np.zeros(0, dtype=np.int64)
             group_facet = first_point // nq
             B2 = np.einsum("fqac,fqk->fqakc", R, partners.N2).reshape(n_f * nq, 3, 3 * n_close)
             B = np.zeros((n_g, nqs, 3, 6 * n_close))
-            B[group, slot] = np.concatenate([B1.reshape(n_f * nq, 3, 3 * n_close), B2],
-                                            axis=2)
+            B[group, slot] = np.concatenate([B1.reshape(n_f * nq, 3, 3 * n_close)[own],
+                                             B2[own]], axis=2)
             nodes = np.concatenate([nodes1[group_facet],
                                     partners.nodes2.reshape(n_f * nq, n_close)[first_point]],
                                    axis=1)
             self._jump0[:, 0] += partners.gap0.reshape(-1)
             self.n_remote_partners = int(np.sum(partners.remote.reshape(-1)[first_point]))
-            groups_of_facet = group
-        point_slot = (groups_of_facet if partners is not None else np.repeat(groups_of_facet, nq)
-                      ) * nqs + slot
+            point_slot = np.empty(n_f * nq, dtype=np.int64)
+            point_slot[own] = group * nqs + slot
+            copies = np.flatnonzero(copy_of >= 0)
+            point_slot[copies] = point_slot[copy_of[copies]]
+        if partners is None:
+            point_slot = np.repeat(groups_of_facet, nq) * nqs + slot
         pair_dofs = (3 * nodes[:, :, None] + np.arange(3)).reshape(n_g, 3 * nodes.shape[1])
         order = np.argsort(pair_dofs, axis=1)
         pair_dofs = np.take_along_axis(pair_dofs, order, axis=1)
@@ -675,6 +685,8 @@ class ContactInterface:
         self._Bf = B.reshape(n_g, nqs * 3, self._n_pair_dofs)  # per-group view for matmul
         self._BfT = np.ascontiguousarray(np.swapaxes(self._Bf, 1, 2))
         self._point_slot = point_slot.astype(np.int64)
+        self._own_slot = (np.ones(n_f * nq, dtype=bool) if partners is None or
+                          partners.copy_of is None else partners.copy_of.reshape(-1) < 0)
         self._identity_slots = bool(n_g * nqs == n_f * nq and
                                     np.array_equal(point_slot, np.arange(n_f * nq)))
         self._pair_nodes = nodes  # (n_g, n_nodes_pair) global block indices
@@ -688,7 +700,8 @@ class ContactInterface:
         if self._identity_slots:
             return values
         out = np.zeros((self.n_groups * self._nqs,) + values.shape[1:])
-        out[self._point_slot] = values
+        own = self._own_slot
+        out[self._point_slot[own]] = values[own]   # slot-filling copies carry weight 0
         return out
 
     def _communication(self, bcs) -> None:
@@ -971,25 +984,28 @@ class ContactInterface:
     def n_contact(self) -> int:
         """Global number of points in contact (p > 0) at the last evaluation (collective, one
         allreduce: cheap enough for every Jacobian)."""
-        return self.comm.allreduce(int(self._result().contact.sum()), op=MPI.SUM)
+        return self.comm.allreduce(int((self._result().contact & self._own_slot).sum()),
+                                   op=MPI.SUM)
 
     def summary(self) -> InterfaceSummary:
         """Global figures after the last evaluation (collective: two allreduces)."""
         res = self._result()
         w = self._weights
+        own = self._own_slot    # counts skip the mortar pairing's slot-filling copies
         force = np.einsum("pai,pa,p->i", self._R, res.traction, w)
         sums = np.concatenate([force, [
             float(np.dot(res.area_fraction, w)), float(w.sum()), float(w[res.contact].sum()),
             float(w[res.slipping].sum()), float(np.dot(self.history.dissipated, w)),
-            float(res.contact.sum()), float(res.slipping.sum()),
-            0.0 if res.beyond_validity is None else float(res.beyond_validity.sum())]])
+            float((res.contact & own).sum()), float((res.slipping & own).sum()),
+            0.0 if res.beyond_validity is None else float((res.beyond_validity & own).sum()),
+            float(own.sum())]])
         sums = self.comm.allreduce(sums, op=MPI.SUM)
         slip = np.linalg.norm(self._last_jump[:, 1:], axis=1)
         plastic = np.linalg.norm(self.history.trial.plastic_slip, axis=1)
         maxima = np.array([slip.max(initial=0.0), plastic.max(initial=0.0)])
         self.comm.Allreduce(MPI.IN_PLACE, maxima, op=MPI.MAX)
         return InterfaceSummary(
-            n_points=self.n_points_global, n_contact=int(sums[8]), n_slipping=int(sums[9]),
+            n_points=int(sums[11]), n_contact=int(sums[8]), n_slipping=int(sums[9]),
             contact_force=sums[:3], real_area=float(sums[3]), nominal_area=float(sums[4]),
             contact_area=float(sums[5]), slipping_area=float(sums[6]),
             max_slip=float(maxima[0]), max_plastic_slip=float(maxima[1]),
@@ -1159,6 +1175,8 @@ class _Partners:
         facet: (n_f, nq) partner facet id (an index into the gathered second surface).
         remote: (n_f, nq) bool: the partner facet is owned by another rank.
         gap0: (n_f, nq) initial normal gap [mm] (0 for conforming pairs).
+        copy_of: (n_f, nq) or None: for slot-filling points (weight 0, see the mortar
+            pairing) the index of the point they repeat (-1 for a point of its own).
     """
 
     N2: np.ndarray
@@ -1166,6 +1184,7 @@ class _Partners:
     facet: np.ndarray
     remote: np.ndarray
     gap0: np.ndarray
+    copy_of: Optional[np.ndarray] = None
 
 
 @dataclass(frozen=True)

@@ -16,7 +16,8 @@ Decisions (docs/nonmatching.md):
 * **Exact on curved geometry.** X2 is the second facet's own geometry map (P1 or P2 cells,
   tetrahedra or hexahedra): the point is found by a vectorised Newton iteration in the facet's
   reference coordinates (3 x 3 systems, quadratic convergence; one step on flat P1 facets).
-* **Candidates** are the ``n_candidates`` second facets whose centroids are nearest to x
+* **Candidates** are the 4 (then, for the points left without partner, ``n_candidates``)
+  second facets whose centroids are nearest to x
   (KD-tree of an all-gathered copy of the second surface, as for conforming pairs); a candidate
   is accepted if Newton converged, xi lies in the facet (tolerance ``inside_tol``), |t| is
   within the search radius and the two surfaces face each other there (n . n2 < 0, n2 the
@@ -98,7 +99,8 @@ def project_points(x: np.ndarray, normal: np.ndarray, surface: SecondSurface, cm
         surface: the gathered second surface.
         cmap: the basix coordinate element of the mesh (``tabulate(1, X)``).
         search_radius: largest accepted |t| [mm].
-        n_candidates: second facets tried per point (nearest centroids).
+        n_candidates: second facets tried per point (nearest centroids): the 4 nearest
+            first, then ``n_candidates`` for the points those leave without partner.
         inside_tol: tolerance on the facet coordinates for "inside the facet".
         max_iter: Newton iterations.
 
@@ -139,23 +141,27 @@ def _newton_on_facets(xp, nrm, surface, c, cmap, max_iter=25, inside_tol=1e-8):
     t = np.zeros(m)
     scale = np.linalg.norm(Xn.max(axis=1) - Xn.min(axis=1), axis=1) if m else np.zeros(0)
     converged = np.zeros(m, dtype=bool)
+    act = np.arange(m)          # active set: pairs still iterating
     for _ in range(max_iter):
-        X_ref = v0 + np.einsum("pij,pj->pi", T, xi)
-        tab = tabulate(cmap, 1, X_ref)  # (4, m, n_gdof)
-        dphi = np.moveaxis(tab[1:], 0, -1)  # (m, n_gdof, 3)
-        X = np.einsum("pk,pki->pi", tab[0], Xn)
-        dX = np.einsum("pki,pkd,pdj->pij", Xn, dphi, T)  # (m, 3, 2)
-        F = X - xp - t[:, None] * nrm
-        J = np.concatenate([dX, -nrm[:, :, None]], axis=2)
-        ok = np.abs(np.linalg.det(J)) > 1e-300
-        step = np.zeros((m, 3))
-        step[ok] = np.linalg.solve(J[ok], -F[ok][:, :, None])[..., 0]
-        xi = xi + step[:, :2]
-        t = t + step[:, 2]
-        converged = ok & (np.linalg.norm(step[:, :2], axis=1) <= 1e-13) & (
-            np.abs(step[:, 2]) <= 1e-13 * np.maximum(scale, 1e-300))
-        if converged.all():
+        if act.size == 0:
             break
+        Xa, Ta = Xn[act], T[act]
+        tab = tabulate(cmap, 1, v0[act] + np.einsum("pij,pj->pi", Ta, xi[act]))
+        dphi = np.moveaxis(tab[1:], 0, -1)  # (a, n_gdof, 3)
+        X = np.einsum("pk,pki->pi", tab[0], Xa)
+        dX = np.einsum("pid,pdj->pij", np.einsum("pki,pkd->pid", Xa, dphi), Ta)  # (a, 3, 2)
+        F = X - xp[act] - t[act, None] * nrm[act]
+        J = np.concatenate([dX, -nrm[act][:, :, None]], axis=2)
+        ok = np.abs(np.linalg.det(J)) > 1e-300
+        step = np.zeros((act.size, 3))
+        step[ok] = np.linalg.solve(J[ok], -F[ok][:, :, None])[..., 0]
+        xi[act] += step[:, :2]
+        t[act] += step[:, 2]
+        done = ok & (np.abs(step[:, :2]).max(axis=1) <= 1e-12 * (1.0 + np.abs(xi[act]).max(
+            axis=1))) & (np.abs(step[:, 2]) <= 1e-12 * (scale[act] + np.abs(t[act])))
+        converged[act[done]] = True
+        hopeless = ~ok | (np.abs(xi[act]).max(axis=1) > 10.0)   # far outside the facet
+        act = act[~done & ~hopeless]
     X_ref = v0 + np.einsum("pij,pj->pi", T, xi)
     if surface.triangle:
         inside = (xi >= -inside_tol).all(axis=1) & (xi.sum(axis=1) <= 1.0 + inside_tol)
@@ -179,8 +185,28 @@ def _project(x, normal, surface, cmap, search_radius, n_candidates, inside_tol, 
     if n == 0 or surface.size == 0:
         return Projection(facet, X_best, np.zeros(n), np.full(n, np.inf),
                           np.zeros(n, dtype=bool))
-    k = int(min(n_candidates, surface.size))
-    _, cand = cKDTree(surface.centroid).query(x, k=k)
+    tree = cKDTree(surface.centroid)
+    # first pass: the 4 nearest facets find almost every partner; the points they fail are
+    # tried again with n_candidates
+    first = _candidates(x, normal, surface, tree, min(4, n_candidates), cmap, search_radius,
+                        inside_tol, max_iter)
+    retry = first.facet < 0
+    if retry.any() and n_candidates > 4:
+        again = _candidates(x[retry], normal[retry], surface, tree, n_candidates, cmap,
+                            search_radius, inside_tol, max_iter)
+        merged = [getattr(first, f).copy() for f in Projection.__dataclass_fields__]
+        for arr, new in zip(merged, (getattr(again, f) for f in Projection.__dataclass_fields__)):
+            arr[retry] = new
+        return Projection(*merged)
+    return first
+
+
+def _candidates(x, normal, surface, tree, k, cmap, search_radius, inside_tol, max_iter):
+    n = x.shape[0]
+    facet = np.full(n, -1, dtype=np.int64)
+    X_best = np.zeros((n, 3))
+    k = int(min(k, surface.size))
+    _, cand = tree.query(x, k=k)
     cand = np.asarray(cand).reshape(n, k)
     pts = np.repeat(np.arange(n), k)
     c = cand.ravel()

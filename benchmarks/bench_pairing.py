@@ -1,0 +1,153 @@
+"""Non-matching interfaces: patch-test accuracy of the pairings, and their cost at scale.
+
+    OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bench_pairing.py [--part accuracy|cost|all]
+        [--points 10000 50000 200000]
+
+Part "accuracy": two blocks meshed independently (``separate_blocks``), uniform pressure
+p = 80 MPa on top, bilateral linear penalty 1e6 MPa/mm, lower block E/2: largest pointwise
+|p - 80| / 80 at the interface points with weight > 0, for the Gauss-point projection
+(``pairing="projection"``, facet rule of degree 2 x order, and a richer rule) and the
+segment-to-segment integration (``pairing="mortar"``, triangle rule of degree 2 x order on the
+pieces).
+
+Part "cost": thin hexahedral blocks (Q1, one element layer each, facet rule of degree 2: 4 points
+per facet) with about N interface points; equal element sizes (the conforming pairing applies)
+and sizes 5:7 (non-matching). Per pairing: set-up time of ``ContactInterface`` (pairing included),
+and the time of one interface residual + Jacobian assembly (law: Coulomb penalty) next to
+DOLFINx's assembly of the bulk elasticity Jacobian of the same mesh — a Newton iteration costs at
+least the bulk assembly plus a linear solve, so the ratio is an upper bound of the interface's
+share. Serial. Units: mm, N, MPa, s.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+import numpy as np
+import ufl
+from mpi4py import MPI
+from petsc4py import PETSc
+
+import dolfinx
+import dolfinx.fem.petsc
+from dolfinx import fem
+from rough_contact.fem.contact import ContactInterface
+from rough_contact.fem.problem import ContactProblem, Material, SurfaceLoad
+from rough_contact.interface.penalty import LinearPenalty, SoftplusPenalty
+from rough_contact.scenes.meshes.blocks import separate_blocks
+from rough_contact.solver.snes import SNESSolver
+
+E, NU, P = 2.0e5, 0.25, 80.0
+
+
+def _roller(V, scene, name, comp):
+    dofs = fem.locate_dofs_topological(V.sub(comp), 2, scene.facet_tags.find(scene.tag(name)))
+    return fem.dirichletbc(PETSc.ScalarType(0.0), dofs, V.sub(comp))
+
+
+def patch_error(cell_type, order, size_lower, size_upper, first, pairing, degree):
+    scene = separate_blocks(h1=1.0, h2=0.5, size_lower=size_lower, size_upper=size_upper,
+                            order=order, cell_type=cell_type)
+    V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", order))
+    bcs = [_roller(V, scene, "x0", 0), _roller(V, scene, "y0", 1),
+           _roller(V, scene, "bottom", 2)]
+    a, b = scene.contact_pair if first == "upper" else scene.contact_pair[::-1]
+    ci = ContactInterface(V, scene.facet_tags, a, b, law=LinearPenalty(1e6), bcs=bcs,
+                          quadrature_degree=degree, pairing=pairing)
+    mats = {scene.tag("upper"): Material(E, NU), scene.tag("lower"): Material(0.5 * E, NU)}
+    problem = ContactProblem(V, mats, bcs, [SurfaceLoad(scene.tag("top"), traction=[0, 0, -P])],
+                             cell_tags=scene.cell_tags, facet_tags=scene.facet_tags,
+                             interface=ci)
+    solver = SNESSolver(problem, prefix="bench_pairing_")
+    problem.set_load_factor(1.0)
+    solver.solve()
+    ci.evaluate(problem.u)
+    pf = ci.point_fields()
+    real = pf.weight > 0
+    err = MPI.COMM_WORLD.allreduce(float(np.abs(pf.pressure[real] - P).max(initial=0.0)),
+                                   op=MPI.MAX) / P
+    n = MPI.COMM_WORLD.allreduce(int(real.sum()), op=MPI.SUM)
+    solver.destroy()
+    return err, n
+
+
+def accuracy():
+    cases = [("tetrahedron", 1, 0.2, 0.28, "upper"), ("tetrahedron", 2, 0.2, 0.28, "upper"),
+             ("tetrahedron", 1, 0.3, 0.1, "lower"), ("tetrahedron", 1, 0.1, 0.3, "lower"),
+             ("hexahedron", 1, 1 / 5, 1 / 7, "upper"), ("hexahedron", 2, 1 / 5, 1 / 7, "upper"),
+             ("hexahedron", 1, 1 / 3, 1 / 9, "upper"), ("hexahedron", 1, 1 / 3, 1 / 9, "lower")]
+    PETSc.Sys.Print("patch test: max |p - p_applied| / p_applied at the interface points")
+    PETSc.Sys.Print(f"{'cells':>5} {'P':>2} {'h_low':>6} {'h_up':>6} {'first':>6} "
+                    f"{'Gauss 2k':>10} {'pts':>6} {'Gauss 4k+2':>10} {'pts':>6} "
+                    f"{'mortar 2k':>10} {'pts':>6}")
+    for ct, order, hl, hu, first in cases:
+        row = [patch_error(ct, order, hl, hu, first, "projection", 2 * order),
+               patch_error(ct, order, hl, hu, first, "projection", 4 * order + 2),
+               patch_error(ct, order, hl, hu, first, "mortar", 2 * order)]
+        PETSc.Sys.Print(f"{ct[:5]:>5} {order:2d} {hl:6.3f} {hu:6.3f} {first:>6} " + " ".join(
+            f"{e:10.2e} {n:6d}" for e, n in row))
+
+
+def cost(points):
+    PETSc.Sys.Print("\ncost (serial, Q1 hexahedra, 4 points per first facet, Coulomb penalty)")
+    PETSc.Sys.Print(f"{'target':>7} {'meshes':>9} {'pairing':>10} {'points':>8} {'groups':>7} "
+                    f"{'set-up s':>8} {'R+J s':>7} {'bulk J s':>8} {'R+J/bulk':>8}")
+    for n_target in points:
+        n_side = int(round(np.sqrt(n_target / 4.0)))
+        for label, n_up in (("equal", n_side), ("5:7", int(round(n_side * 7 / 5)))):
+            scene = separate_blocks(h1=1.0 / n_side, h2=1.0 / n_side, size_lower=1.0 / n_side,
+                                    size_upper=1.0 / n_up, cell_type="hexahedron")
+            V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", 1))
+            u = fem.Function(V)
+            u.interpolate(lambda x: 1e-4 * np.stack([np.sin(x[0]), np.cos(x[1]), x[2] - 0.5]))
+            du, v = ufl.TrialFunction(V), ufl.TestFunction(V)
+            eps = ufl.sym(ufl.grad(du))
+            lmbda, mu = E * NU / ((1 + NU) * (1 - 2 * NU)), E / (2 * (1 + NU))
+            a = fem.form(ufl.inner(2 * mu * eps + lmbda * ufl.tr(eps) * ufl.Identity(3),
+                                   ufl.sym(ufl.grad(v))) * ufl.dx)
+            pairings = ["conforming", "projection", "mortar"] if label == "equal" else \
+                ["projection", "mortar"]
+            for pairing in pairings:
+                law = SoftplusPenalty(1e6, 1e-6, k_tangential=1e6, friction=0.3)
+                t0 = time.perf_counter()
+                ci = ContactInterface(V, scene.facet_tags, *scene.contact_pair, law=law,
+                                      pairing=pairing)
+                t_setup = time.perf_counter() - t0
+                A = ci.create_matrix(a)
+                b = dolfinx.cpp.la.petsc.create_vector(V.dofmap.index_map, 3)
+                t0 = time.perf_counter()
+                A.zeroEntries()
+                dolfinx.fem.petsc.assemble_matrix(A, a)
+                t_bulk = time.perf_counter() - t0
+                times = []
+                for k in range(3):      # a new u each time: the law is evaluated every time
+                    u.x.array[:] *= 1.0 + 1e-3
+                    u.x.scatter_forward()
+                    t0 = time.perf_counter()
+                    b.set(0.0)
+                    ci.assemble_residual(u, b)
+                    ci.assemble_jacobian(u, A)
+                    times.append(time.perf_counter() - t0)
+                A.assemble()
+                t_if = min(times)
+                PETSc.Sys.Print(f"{n_target:7d} {label:>9} {pairing:>10} {ci.n_points_global:8d} "
+                                f"{ci.n_groups:7d} {t_setup:8.2f} {t_if:7.3f} {t_bulk:8.3f} "
+                                f"{t_if / t_bulk:8.2f}")
+                A.destroy()
+                b.destroy()
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--part", choices=["accuracy", "cost", "all"], default="all")
+    ap.add_argument("--points", type=int, nargs="+", default=[10000, 50000, 200000])
+    args = ap.parse_args(argv)
+    if args.part in ("accuracy", "all"):
+        accuracy()
+    if args.part in ("cost", "all"):
+        cost(args.points)
+
+
+if __name__ == "__main__":
+    main()
