@@ -15,6 +15,12 @@ Labels (tags in brackets):
 fragmented: each block has its own surface mesh on z = 0, with its own element size), the case
 of parts meshed separately; same labels as ``two_blocks``.
 
+``sphere_on_block``: a quarter of an elastic sphere segment (radius R, height ``cap_height``)
+touching a quarter block at the origin, the two meshed independently with different element
+sizes (non-matching); labels "sphere" (1), "block" (2), "sphere_contact" (11: the sphere's
+surface within ``contact_radius`` of the axis), "block_contact" (12: the block's top),
+"sphere_top" (13), "bottom" (14), "symmetry_x" (17), "symmetry_y" (18).
+
 ``block_on_plane``: one block [0, lx] x [0, ly] x [0, h] on the rigid plane z = 0
 (``contact_pair = (contact, None)``, ``rigid_plane = ((0, 0, 0), (0, 0, 1))``).
 Labels: "block" (1), "contact" (11, z = 0), "top" (13), "x0".."y1" (15-18).
@@ -30,7 +36,8 @@ from rough_contact.fem.mesh import (Scene, add_groups, build_scene, entity_cente
                                     set_transfinite_hexahedra, validate_cell_type,
                                     validate_order, validate_positive)
 
-__all__ = ["two_blocks", "separate_blocks", "block_on_plane", "indented_block"]
+__all__ = ["two_blocks", "separate_blocks", "block_on_plane", "indented_block",
+           "sphere_on_block"]
 
 
 def _side_groups(model, lx, ly, tol):
@@ -178,6 +185,117 @@ def separate_blocks(lx: float = 1.0, ly: float = 1.0, h1: float = 1.0, h2: float
         surface_owners={"contact_upper": "upper", "contact_lower": "lower"},
         dimensions=dict(lx=lx, ly=ly, h1=h1, h2=h2, size_lower=size_lower,
                         size_upper=size_upper))
+
+
+def sphere_on_block(radius: float = 10.0, cap_height: float = 1.0, half_width: float = 4.0,
+                    height: float = 4.0, contact_radius: float = 1.0,
+                    contact_size: float = 0.05, size_ratio: float = 0.7,
+                    mesh_size: float = 1.0, transition: float = 1.0,
+                    refined_radius: float = 0.4, order: int = 1,
+                    comm: MPI.Comm = MPI.COMM_WORLD) -> Scene:
+    """Quarter sphere segment on a quarter block, meshed independently. Collective.
+
+    The sphere (centre (0, 0, R)) is cut by the plane z = ``cap_height``; its surface within
+    ``contact_radius`` of the z axis is the first contact surface (a separate face, so that the
+    surface can be paired with the block's top by the mortar pairing, which needs the first
+    surface inside the second). The block is [0, L]^2 x [-H, 0].
+
+    Args:
+        radius, cap_height: sphere radius and segment height [mm].
+        half_width, height: block size L, H [mm].
+        contact_radius: radius of the sphere's contact face [mm] (< the segment's radius).
+        contact_size: element size in the block within ``refined_radius`` of the origin [mm];
+            the sphere gets ``size_ratio`` x that (non-matching surface meshes).
+        mesh_size, transition: far element size and the distance over which sizes grow [mm].
+        order: 1 or 2.
+
+    Returns:
+        The scene; ``contact_pair = (sphere_contact, block_contact)``.
+    """
+    validate_positive(radius=radius, cap_height=cap_height, half_width=half_width,
+                      height=height, contact_radius=contact_radius, contact_size=contact_size,
+                      size_ratio=size_ratio, mesh_size=mesh_size, transition=transition,
+                      refined_radius=refined_radius)
+    validate_order(order)
+    base = float(np.sqrt(radius**2 - (radius - cap_height) ** 2))
+    if cap_height >= radius or contact_radius >= base:
+        raise ValueError(f"sphere_on_block: need cap_height ({cap_height}) < radius ({radius}) "
+                         f"and contact_radius ({contact_radius}) < the segment's base radius "
+                         f"({base:.6g}) [mm]")
+    tol = 1e-6 * max(radius, half_width, height)
+
+    def build(model):
+        import gmsh
+
+        occ = model.occ
+        ball = occ.addSphere(0, 0, radius, radius)
+        box = occ.addBox(0, 0, 0, base * 1.1, base * 1.1, cap_height)
+        seg, _ = occ.intersect([(3, ball)], [(3, box)])
+        cyl = occ.addCylinder(0, 0, -1.0, 0, 0, cap_height + 2.0, contact_radius)
+        inner, _ = occ.intersect([(3, seg[0][1])], [(3, cyl)], removeObject=False,
+                                 removeTool=False)
+        outer, _ = occ.cut([(3, seg[0][1])], [(3, cyl)])
+        pieces, _ = occ.fragment(inner, outer)
+        block = occ.addBox(0, 0, -height, half_width, half_width, height)
+        occ.synchronize()
+        sphere_vols = [t for d, t in pieces if d == 3]
+        add_groups(model, 3, {"sphere": (1, sphere_vols), "block": (2, [block])})
+        sphere_faces = {t for _, t in model.getBoundary([(3, v) for v in sphere_vols],
+                                                        combined=False, oriented=False)}
+        block_faces = {t for _, t in model.getBoundary([(3, block)], oriented=False)}
+        tags, c = entity_centers(model, 2)
+        r = np.hypot(c[:, 0], c[:, 1])
+        curved = [t for t in tags if t in sphere_faces and model.getType(2, t) == "Sphere"]
+        contact = [t for t, ri in zip(tags, r) if t in curved and ri < contact_radius]
+        add_groups(model, 2, {
+            "sphere_contact": (11, contact),
+            "block_contact": (12, [t for t, ci in zip(tags, c)
+                                   if t in block_faces and abs(ci[2]) < tol]),
+            "sphere_top": (13, [t for t, ci in zip(tags, c)
+                                if t in sphere_faces and abs(ci[2] - cap_height) < tol]),
+            "bottom": (14, tags[np.abs(c[:, 2] + height) < tol]),
+            "symmetry_x": (17, tags[np.abs(c[:, 0]) < tol]),
+            "symmetry_y": (18, tags[np.abs(c[:, 1]) < tol])})
+        # one size field per body (restricted to its volumes), the smaller one wins
+        dist = "Sqrt(x^2+y^2+z^2)"
+        field = model.mesh.field
+        fields = []
+        for vols, size in ((sphere_vols, size_ratio * contact_size), ([block], contact_size)):
+            f = field.add("MathEval")
+            field.setString(f, "F", f"(Abs({dist}-{refined_radius})+{dist}-{refined_radius})/2")
+            thr = field.add("Threshold")
+            field.setNumber(thr, "InField", f)
+            field.setNumber(thr, "SizeMin", size)
+            field.setNumber(thr, "SizeMax", mesh_size)
+            field.setNumber(thr, "DistMin", 0.0)
+            field.setNumber(thr, "DistMax", transition)
+            res = field.add("Restrict")
+            field.setNumber(res, "InField", thr)
+            faces = model.getBoundary([(3, v) for v in vols], combined=False, oriented=False)
+            curves = model.getBoundary(faces, combined=False, oriented=False)
+            field.setNumbers(res, "VolumesList", vols)
+            field.setNumbers(res, "SurfacesList", sorted({abs(t) for _, t in faces}))
+            field.setNumbers(res, "CurvesList", sorted({abs(t) for _, t in curves}))
+            fields.append(res)
+        fmin = field.add("Min")
+        field.setNumbers(fmin, "FieldsList", fields)
+        field.setAsBackgroundMesh(fmin)
+        gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
+        gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
+        gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
+        gmsh.option.setNumber("Mesh.MeshSizeMax", mesh_size)
+        model.mesh.generate(3)
+        if order == 2:
+            gmsh.option.setNumber("Mesh.SecondOrderIncomplete", 0)
+            model.mesh.setOrder(2)
+
+    return build_scene(
+        comm, "sphere_on_block", build, split_body="sphere",
+        contact_pair=("sphere_contact", "block_contact"),
+        surface_owners={"sphere_contact": "sphere", "block_contact": "block"},
+        dimensions=dict(radius=radius, cap_height=cap_height, half_width=half_width,
+                        height=height, contact_radius=contact_radius,
+                        contact_size=contact_size, size_ratio=size_ratio))
 
 
 def block_on_plane(lx: float = 1.0, ly: float = 1.0, h: float = 1.0,
