@@ -13,6 +13,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -144,6 +145,30 @@ def test_demo_fretting(tmp_path):
     k = [float(r["secant_stiffness_N_per_mm"]) for r in rows]
     assert abs(e[0]) < 1e-9 * e[1] and e[1] > 0 and k[1] < k[0]
     assert (tmp_path / "fret" / "fretting.png").exists()
+
+
+def _bolt_rows(out):
+    rows = [ln.split() for ln in out.splitlines()
+            if len(ln.split()) == 10 and ln.split()[0].replace(".", "").isdigit()]
+    return np.array([[float(v) for v in r] for r in rows])
+
+
+def test_demo_bolt_head(tmp_path):
+    """A cylinder meshed separately from its block (mortar pairing), rough law with friction,
+    on 1 and 2 ranks: the run checks the force balance (<= 1e-8 of P) at every increment
+    itself; the preload is carried (N = P), the friction force grows with the slide, stays
+    below the largest friction coefficient (0.5) x N, and both runs print the same table."""
+    args = [DEMOS / "demo_bolt_head.py", "--size-cylinder", "1.5", "--size-block", "2.5",
+            "--shear-steps", "2"]
+    tables = [_bolt_rows(run(args, tmp_path, ranks)) for ranks in ((1, 2) if MPIRUN else (1,))]
+    t = tables[0]
+    assert t.shape == (4, 10)
+    P = 10.0 * np.pi * 25.0
+    assert np.allclose(t[1:, 2], P, rtol=1e-4)        # N = P once preloaded (printed digits)
+    assert np.all(np.diff(t[1:, 3]) > 0) and np.all(t[:, 4] <= 0.5)
+    assert np.all(t[:, 8] <= 1e-8)                     # printed balance
+    for other in tables[1:]:
+        np.testing.assert_allclose(other[:, :8], t[:, :8], rtol=1e-3, atol=1e-9)
 
 
 def test_demo_flat_punch_restart(tmp_path):

@@ -21,6 +21,11 @@ sizes (non-matching); labels "sphere" (1), "block" (2), "sphere_contact" (11: th
 surface within ``contact_radius`` of the axis), "block_contact" (12: the block's top),
 "sphere_top" (13), "bottom" (14), "symmetry_x" (17), "symmetry_y" (18).
 
+``cylinder_on_block``: a cylinder (a bolt head, a pin) standing on a block, the two meshed
+independently (the cylinder finer); labels "cylinder" (1), "block" (2), "cylinder_contact" (11:
+its base, the first contact surface), "block_contact" (12: the block's top), "cylinder_top"
+(13), "bottom" (14).
+
 ``block_on_plane``: one block [0, lx] x [0, ly] x [0, h] on the rigid plane z = 0
 (``contact_pair = (contact, None)``, ``rigid_plane = ((0, 0, 0), (0, 0, 1))``).
 Labels: "block" (1), "contact" (11, z = 0), "top" (13), "x0".."y1" (15-18).
@@ -37,7 +42,7 @@ from rough_contact.fem.mesh import (Scene, add_groups, build_scene, entity_cente
                                     validate_order, validate_positive)
 
 __all__ = ["two_blocks", "separate_blocks", "block_on_plane", "indented_block",
-           "sphere_on_block"]
+           "sphere_on_block", "cylinder_on_block"]
 
 
 def _side_groups(model, lx, ly, tol):
@@ -296,6 +301,68 @@ def sphere_on_block(radius: float = 10.0, cap_height: float = 1.0, half_width: f
         dimensions=dict(radius=radius, cap_height=cap_height, half_width=half_width,
                         height=height, contact_radius=contact_radius,
                         contact_size=contact_size, size_ratio=size_ratio))
+
+
+def cylinder_on_block(radius: float = 5.0, height: float = 5.0, half_width: float = 10.0,
+                      block_height: float = 10.0, size_cylinder: float = 1.0,
+                      size_block: float = 1.6, order: int = 1,
+                      comm: MPI.Comm = MPI.COMM_WORLD) -> Scene:
+    """A cylinder of ``radius`` x ``height`` on the block [-L, L]^2 x [-Hb, 0], its base centred
+    on the block's top, meshed independently (non-matching interface). Collective.
+
+    Args:
+        radius, height: cylinder size [mm].
+        half_width, block_height: block size L, Hb [mm] (L > radius).
+        size_cylinder, size_block: element sizes of the two bodies [mm].
+        order: 1 or 2.
+
+    Returns:
+        The scene; ``contact_pair = (cylinder_contact, block_contact)`` (the base lies within the
+        block's top, as the mortar pairing needs of the first surface).
+    """
+    validate_positive(radius=radius, height=height, half_width=half_width,
+                      block_height=block_height, size_cylinder=size_cylinder,
+                      size_block=size_block)
+    validate_order(order)
+    if half_width <= radius:
+        raise ValueError(f"cylinder_on_block: half_width = {half_width} mm must exceed radius "
+                         f"= {radius} mm (the base must lie on the block's top)")
+    tol = 1e-6 * max(radius, height, half_width, block_height)
+
+    def build(model):
+        import gmsh
+
+        cyl = model.occ.addCylinder(0, 0, 0, 0, 0, height, radius)
+        block = model.occ.addBox(-half_width, -half_width, -block_height, 2 * half_width,
+                                 2 * half_width, block_height)
+        model.occ.synchronize()           # not fragmented: two independent meshes
+        add_groups(model, 3, {"cylinder": (1, [cyl]), "block": (2, [block])})
+        cyl_faces = {t for _, t in model.getBoundary([(3, cyl)], oriented=False)}
+        tags, c = entity_centers(model, 2)
+        z = c[:, 2]
+        add_groups(model, 2, {
+            "cylinder_contact": (11, [t for t, zi in zip(tags, z)
+                                      if t in cyl_faces and abs(zi) < tol]),
+            "block_contact": (12, [t for t, zi in zip(tags, z)
+                                   if t not in cyl_faces and abs(zi) < tol]),
+            "cylinder_top": (13, tags[np.abs(z - height) < tol]),
+            "bottom": (14, tags[np.abs(z + block_height) < tol])})
+        for vol, size in ((cyl, size_cylinder), (block, size_block)):
+            points = model.getBoundary([(3, vol)], recursive=True)
+            model.mesh.setSize(points, size)
+        gmsh.option.setNumber("Mesh.MeshSizeMax", max(size_cylinder, size_block))
+        model.mesh.generate(3)
+        if order == 2:
+            gmsh.option.setNumber("Mesh.SecondOrderIncomplete", 0)
+            model.mesh.setOrder(2)
+
+    return build_scene(
+        comm, "cylinder_on_block", build, split_body="cylinder",
+        contact_pair=("cylinder_contact", "block_contact"),
+        surface_owners={"cylinder_contact": "cylinder", "block_contact": "block"},
+        dimensions=dict(radius=radius, height=height, half_width=half_width,
+                        block_height=block_height, size_cylinder=size_cylinder,
+                        size_block=size_block))
 
 
 def block_on_plane(lx: float = 1.0, ly: float = 1.0, h: float = 1.0,
