@@ -16,7 +16,8 @@ Decisions (docs/nonmatching.md):
 * **Exact on curved geometry.** X2 is the second facet's own geometry map (P1 or P2 cells,
   tetrahedra or hexahedra): the point is found by a vectorised Newton iteration in the facet's
   reference coordinates (3 x 3 systems, quadratic convergence; one step on flat P1 facets).
-* **Candidates** are the 4 (then, for the points left without partner, ``n_candidates``)
+* **Candidates** are the 4 (then, for the points left without partner, ``n_candidates``,
+  then every facet whose centroid is within the search radius + the largest facet radius)
   second facets whose centroids are nearest to x
   (KD-tree of an all-gathered copy of the second surface, as for conforming pairs); a candidate
   is accepted if Newton converged, xi lies in the facet (tolerance ``inside_tol``), |t| is
@@ -186,32 +187,58 @@ def _project(x, normal, surface, cmap, search_radius, n_candidates, inside_tol, 
         return Projection(facet, X_best, np.zeros(n), np.full(n, np.inf),
                           np.zeros(n, dtype=bool))
     tree = cKDTree(surface.centroid)
-    # first pass: the 4 nearest facets find almost every partner; the points they fail are
-    # tried again with n_candidates
-    first = _candidates(x, normal, surface, tree, min(4, n_candidates), cmap, search_radius,
-                        inside_tol, max_iter)
-    retry = first.facet < 0
-    if retry.any() and n_candidates > 4:
-        again = _candidates(x[retry], normal[retry], surface, tree, n_candidates, cmap,
+    # pass 1: the 4 nearest facets find almost every partner; pass 2: n_candidates nearest for
+    # the points pass 1 left without partner; pass 3: every facet whose centroid lies within
+    # the search radius + the largest facet radius (elongated facets, steep normals)
+    result = _candidates(x, normal, surface, _nearest(tree, x, min(4, n_candidates)), cmap,
+                         search_radius, inside_tol, max_iter)
+    radius = search_radius + float(np.max(np.linalg.norm(
+        surface.cell_x - surface.centroid[:, None, :], axis=2)))
+    for finder in (lambda xs: _nearest(tree, xs, n_candidates),
+                   lambda xs: _within(tree, xs, radius)):
+        retry = np.flatnonzero(result.facet < 0)
+        if retry.size == 0:
+            break
+        again = _candidates(x[retry], normal[retry], surface, finder(x[retry]), cmap,
                             search_radius, inside_tol, max_iter)
-        merged = [getattr(first, f).copy() for f in Projection.__dataclass_fields__]
+        merged = [getattr(result, f).copy() for f in Projection.__dataclass_fields__]
         for arr, new in zip(merged, (getattr(again, f) for f in Projection.__dataclass_fields__)):
             arr[retry] = new
-        return Projection(*merged)
-    return first
+        result = Projection(*merged)
+    return result
 
 
-def _candidates(x, normal, surface, tree, k, cmap, search_radius, inside_tol, max_iter):
-    n = x.shape[0]
+def _nearest(tree, x, k):
+    """(n, k) indices of the k nearest centroids."""
+    k = int(min(k, tree.n))
+    return np.asarray(tree.query(x, k=k)[1]).reshape(x.shape[0], k)
+
+
+def _within(tree, x, radius):
+    """(n, k) indices of all centroids within radius (-1 padding)."""
+    counts = tree.query_ball_point(x, radius, return_length=True)
+    k = int(min(max(int(np.max(counts, initial=1)), 1), tree.n))
+    d, cand = tree.query(x, k=k, distance_upper_bound=radius)
+    cand = np.asarray(cand).reshape(x.shape[0], k)
+    return np.where(cand < tree.n, cand, -1)
+
+
+def _candidates(x, normal, surface, cand, cmap, search_radius, inside_tol, max_iter):
+    n, k = cand.shape
     facet = np.full(n, -1, dtype=np.int64)
     X_best = np.zeros((n, 3))
-    k = int(min(k, surface.size))
-    _, cand = tree.query(x, k=k)
-    cand = np.asarray(cand).reshape(n, k)
-    pts = np.repeat(np.arange(n), k)
-    c = cand.ravel()
-    X_ref, t, converged, inside, facing = _newton_on_facets(
+    valid = (cand >= 0).ravel()
+    pts = np.repeat(np.arange(n), k)[valid]
+    c = cand.ravel()[valid]
+    m = valid.size
+    X_ref = np.zeros((m, 3))
+    t = np.zeros(m)
+    converged = np.zeros(m, dtype=bool)
+    inside = np.zeros(m, dtype=bool)
+    facing = np.zeros(m, dtype=bool)
+    X_ref[valid], t[valid], converged[valid], inside[valid], facing[valid] = _newton_on_facets(
         x[pts], normal[pts], surface, c, cmap, max_iter, inside_tol)
+    c = np.where(valid, cand.ravel(), -1)
     geometric = converged & inside
     within = geometric & (np.abs(t) <= search_radius)
     accepted = within & facing
