@@ -402,14 +402,15 @@ def block_on_plane(lx: float = 1.0, ly: float = 1.0, h: float = 1.0,
 
 def indented_block(half_width: float = 4.0, height: float = 4.0, mesh_size: float = 1.0,
                    contact_size: float = 0.05, transition: float = 1.0,
-                   refined_radius: float = 0.4, order: int = 1,
+                   refined_radius: float = 0.4, order: int = 1, half: bool = False,
                    comm: MPI.Comm = MPI.COMM_WORLD) -> Scene:
     """Quarter of a block [0, L] x [0, L] x [-H, 0] for an indenter touching its top at the
-    origin: element size ``contact_size`` within ``refined_radius`` of the origin, growing to
+    origin (or, with ``half``, the half [-L, L] x [0, L] x [-H, 0], for loads along x):
+    element size ``contact_size`` within ``refined_radius`` of the origin, growing to
     ``mesh_size`` over a further ``transition`` [mm]. Collective.
 
     Labels: "block" (1); "contact" (11): top z = 0; "bottom" (14): z = -H;
-    "symmetry_x" (17): x = 0; "symmetry_y" (18): y = 0.
+    "symmetry_x" (17): x = 0 (empty for ``half``); "symmetry_y" (18): y = 0.
     The scene's rigid plane (metadata only) is z = 0 with normal -z; pass the real indenter
     to ``ContactInterface(rigid=...)``.
     """
@@ -420,14 +421,18 @@ def indented_block(half_width: float = 4.0, height: float = 4.0, mesh_size: floa
     tol = 1e-6 * max(half_width, height)
 
     def build(model):
-        box = model.occ.addBox(0, 0, -height, half_width, half_width, height)
+        x0 = -half_width if half else 0.0
+        box = model.occ.addBox(x0, 0, -height, half_width - x0, half_width, height)
         model.occ.synchronize()
         add_groups(model, 3, {"block": (1, [box])})
         tags, c = entity_centers(model, 2)
-        add_groups(model, 2, {"contact": (11, tags[np.abs(c[:, 2]) < tol]),
-                              "bottom": (14, tags[np.abs(c[:, 2] + height) < tol]),
-                              "symmetry_x": (17, tags[np.abs(c[:, 0]) < tol]),
-                              "symmetry_y": (18, tags[np.abs(c[:, 1]) < tol])})
+        groups = {"contact": (11, tags[np.abs(c[:, 2]) < tol]),
+                  "bottom": (14, tags[np.abs(c[:, 2] + height) < tol]),
+                  "symmetry_x": (17, tags[np.abs(c[:, 0]) < tol]),
+                  "symmetry_y": (18, tags[np.abs(c[:, 1]) < tol])}
+        if half:
+            del groups["symmetry_x"]
+        add_groups(model, 2, groups)
         r = "Sqrt(x^2+y^2+z^2)"
         refine_towards(model, f"(Abs({r}-{refined_radius})+{r}-{refined_radius})/2",
                        contact_size, mesh_size, transition)

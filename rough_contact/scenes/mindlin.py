@@ -1,0 +1,209 @@
+"""Cattaneo–Mindlin and Mindlin–Deresiewicz: a rigid sphere on an elastic block with Coulomb
+friction, normal load then tangential load, against the closed forms.
+
+Closed forms (rigid sphere of radius R on an elastic half-space of shear modulus G and Poisson
+ratio nu; normal force P, Hertz radius a = (3 P R / (4 E*))^(1/3), E* = E / (1 - nu^2); Coulomb
+coefficient mu; tangential force Q rising monotonically from 0; q = Q / (mu P)), valid when the
+normal and tangential problems decouple (nu -> 1/2 for a rigid indenter: the coupling parameter
+(1 - 2 nu) / (2 (1 - nu)) vanishes):
+
+* stick radius c / a = (1 - q)^(1/3) (the slip annulus c < r < a grows from the edge);
+* tangential approach delta(Q) = K [1 - (1 - q)^(2/3)], K = 3 mu P (2 - nu) / (16 G a), whose
+  initial slope is the stiffness of a stuck circular contact, 8 G a / (2 - nu);
+* energy dissipated per full cycle between +Q* and -Q* (Masing's rule applied to delta(Q)):
+  W = 9 mu^2 P^2 (2 - nu) / (10 G a) [1 - (1 - q*)^(5/3) - (5 q* / 6) (1 + (1 - q*)^(2/3))],
+  q* = Q* / (mu P); for small q* it tends to (2 - nu) Q*^3 / (36 G a mu P) (cubic in the
+  amplitude). tests/unit/test_mindlin_closed_forms.py checks W against the numerical loop area
+  of the Masing branches and the cubic limit against the series.
+
+FE scene (``run``): HALF block [-L, L] x [0, L] x [-H, 0] (``indented_block(half=True)``;
+symmetry u_y = 0 on y = 0; the tangential load along x keeps that symmetry), a
+``RigidSphere`` touching the top at the origin, ``SoftplusPenalty`` with isotropic Coulomb
+friction (stiff normal and tangential penalties). The bottom is pushed up by u_z = delta_n
+(channel ``normal``, ramped then held) and moved along x by u_x = s (channel ``shear``); the
+total forces are twice the bottom reactions. The stick radius of the FE solution is estimated
+from areas, c / a = sqrt(1 - A_slip / A_contact) (A = nominal areas of the slipping and of the
+contact points, contact meaning p > 1e-3 p_max: the softplus law is positive everywhere): an
+area average, less sensitive to the point spacing than the radius of the outermost stuck
+point.
+
+Units: mm, N, MPa.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from dolfinx import fem
+from rough_contact.fem.contact import ContactInterface
+from rough_contact.fem.problem import ContactProblem, Material, PrescribedDisplacement
+from rough_contact.fem.rigid import RigidSphere
+from rough_contact.interface.penalty import SoftplusPenalty
+from rough_contact.scenes.meshes.blocks import indented_block
+from rough_contact.solver.loading import load_path
+from rough_contact.solver.program import LoadProgram
+from rough_contact.solver.snes import SNESSolver
+from rough_contact.validation import check_scalar
+
+__all__ = ["ParaboloidIndenter", "stick_ratio", "tangential_approach", "energy_per_cycle",
+           "energy_per_cycle_small", "run"]
+
+
+def _q(Q, mu, P) -> np.ndarray:
+    check_scalar("P", P, lo=0.0, unit="N")
+    check_scalar("mu", mu, lo=0.0)
+    q = np.abs(np.asarray(Q, dtype=float)) / (mu * P)
+    if np.any(~np.isfinite(q)) or np.any(q > 1.0):
+        raise ValueError(f"Q / (mu P) = {np.max(q):.6g} is invalid: the closed forms need "
+                         "0 <= |Q| <= mu P (beyond it the contact slides)")
+    return q
+
+
+def stick_ratio(Q, mu: float, P: float) -> np.ndarray:
+    """c / a = (1 - Q / (mu P))^(1/3)."""
+    return (1.0 - _q(Q, mu, P)) ** (1.0 / 3.0)
+
+
+def tangential_approach(Q, mu: float, P: float, a: float, G: float, nu: float) -> np.ndarray:
+    """delta(Q) = 3 mu P (2 - nu) / (16 G a) [1 - (1 - Q / (mu P))^(2/3)] [mm]."""
+    q = _q(Q, mu, P)
+    check_scalar("a", a, lo=0.0, unit="mm")
+    check_scalar("G", G, lo=0.0, unit="MPa")
+    return 3.0 * mu * P * (2.0 - nu) / (16.0 * G * a) * (1.0 - (1.0 - q) ** (2.0 / 3.0))
+
+
+def energy_per_cycle(Q_amplitude, mu: float, P: float, a: float, G: float,
+                     nu: float) -> np.ndarray:
+    """Mindlin–Deresiewicz energy per full cycle +-Q* [N mm]."""
+    q = _q(Q_amplitude, mu, P)
+    check_scalar("a", a, lo=0.0, unit="mm")
+    check_scalar("G", G, lo=0.0, unit="MPa")
+    return 9.0 * mu**2 * P**2 * (2.0 - nu) / (10.0 * G * a) * (
+        1.0 - (1.0 - q) ** (5.0 / 3.0) - 5.0 * q / 6.0 * (1.0 + (1.0 - q) ** (2.0 / 3.0)))
+
+
+def energy_per_cycle_small(Q_amplitude, mu: float, P: float, a: float, G: float,
+                           nu: float) -> np.ndarray:
+    """The small-amplitude limit (2 - nu) Q*^3 / (36 G a mu P) [N mm]."""
+    _q(Q_amplitude, mu, P)
+    return (2.0 - nu) * np.abs(Q_amplitude) ** 3 / (36.0 * G * a * mu * P)
+
+
+class ParaboloidIndenter:
+    """The indenter of Hertz's and Mindlin's theory: the paraboloid z = r^2 / (2 R) over the
+    origin with the gap measured vertically and the normal -z everywhere (the half-space,
+    small-slope idealisation: tangential slip is horizontal). A
+    :class:`rough_contact.fem.rigid.RigidSurface`.
+
+    With the exact sphere (``RigidSphere``), the local frames tilt by r / R and the block's
+    vertical motion u_z shows as a tangential jump u_z r / R, which is of the order of
+    Mindlin's tangential compliance near the contact edge: the exact-sphere kinematics is not
+    the one the closed forms describe.
+    """
+
+    def __init__(self, radius: float):
+        self.radius = check_scalar("radius", radius, lo=0.0, unit="mm")
+
+    def gap_and_normal(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        x = np.asarray(x, dtype=float).reshape(-1, 3)
+        g = (x[:, 0] ** 2 + x[:, 1] ** 2) / (2.0 * self.radius) - x[:, 2]
+        return g, np.broadcast_to(np.array([0.0, 0.0, -1.0]), x.shape).copy()
+
+
+def _program(preload_steps: int, shear_steps: int, cycles: int) -> LoadProgram:
+    """``normal`` ramps to 1 over t in [0, 1]; ``shear``: monotonic 0 -> 1 over [1, 2]
+    (``cycles`` = 0) or triangle cycles 0 -> 1 -> -1 -> 0 of unit length (``shear_steps`` per
+    cycle, a multiple of 4)."""
+    def ramp(t):
+        return min(max(t, 0.0), 1.0)
+
+    def shear(t):
+        if t <= 1.0:
+            return 0.0
+        if cycles == 0:
+            return ramp(t - 1.0)
+        s = (t - 1.0) % 1.0
+        return 4.0 * s if s <= 0.25 else 2.0 - 4.0 * s if s <= 0.75 else 4.0 * s - 4.0
+
+    times = [(i + 1) / preload_steps for i in range(preload_steps)]
+    n = shear_steps * max(cycles, 1)
+    times += [1.0 + (j + 1) / shear_steps for j in range(n)]
+    return LoadProgram({"normal": ramp, "shear": shear}, times,
+                       cycle_start=1.0 if cycles else None)
+
+
+def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5, nu=0.49,
+        mu=0.3, penalty=1e8, half_width=4.0, height=4.0, mesh_size=1.0, preload_steps=2,
+        shear_steps=12, cycles=0, indenter="paraboloid", comm=MPI.COMM_WORLD,
+        verbose=False) -> dict:
+    """Normal indentation by ``delta`` [mm], then a tangential bottom displacement: monotonic to
+    ``slide`` [mm] (``cycles`` = 0) or ``cycles`` triangle cycles of amplitude ``slide``.
+
+    ``indenter``: ``"paraboloid"`` (:class:`ParaboloidIndenter`, the closed forms'
+    kinematics) or ``"sphere"`` (the exact rigid sphere).
+
+    ``slide`` defaults to the approach at which Mindlin's Q reaches mu P for Hertz's P at
+    ``delta`` plus the block's shear compliance (so the last increments slide).
+
+    Returns (identical on every rank): per increment the bottom slide s, the total normal
+    force P and tangential force Q (twice the bottom reactions), the FE stick ratio
+    sqrt(1 - A_slip / A_contact), the contact area, the committed dissipation D (total,
+    twice the half model's); and the scene's constants (a from Hertz at the final P, G, DOFs).
+    """
+    check_scalar("delta", delta, lo=0.0, unit="mm")
+    check_scalar("mu", mu, lo=0.0)
+    if cycles and shear_steps % 4:
+        raise ValueError(f"shear_steps = {shear_steps} is invalid for cycles: it must be a "
+                         "multiple of 4")
+    G = E / (2.0 * (1.0 + nu))
+    E_star = E / (1.0 - nu**2)
+    if slide is None:
+        P_h = 4.0 / 3.0 * E_star * np.sqrt(radius) * delta**1.5
+        a_h = (3.0 * P_h * radius / (4.0 * E_star)) ** (1.0 / 3.0)
+        slide = 3.0 * mu * P_h * (2.0 - nu) / (16.0 * G * a_h) + \
+            mu * P_h * height / (G * 2.0 * half_width * half_width)
+    check_scalar("slide", slide, lo=0.0, unit="mm")
+    scene = indented_block(half_width=half_width, height=height, mesh_size=mesh_size,
+                           contact_size=contact_size, transition=1.0, order=order, half=True,
+                           comm=comm)
+    V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", order))
+    sym = fem.dirichletbc(PETSc.ScalarType(0.0), fem.locate_dofs_topological(
+        V.sub(1), 2, scene.facet_tags.find(scene.tag("symmetry_y"))), V.sub(1))
+    law = SoftplusPenalty(penalty, 1e-3 * delta, k_tangential=penalty, friction=mu)
+    if indenter not in ("paraboloid", "sphere"):
+        raise ValueError(f"indenter = {indenter!r} is invalid: 'paraboloid' or 'sphere'")
+    rigid = ParaboloidIndenter(radius) if indenter == "paraboloid" else \
+        RigidSphere((0.0, 0.0, radius), radius)
+    ci = ContactInterface(V, scene.facet_tags, scene.tag("contact"), law=law,
+                          rigid=rigid, bcs=[sym],
+                          quadrature_degree=2 * order, grain_direction=(1.0, 0.0, 0.0))
+    bottom = scene.tag("bottom")
+    prog = _program(preload_steps, shear_steps, cycles)
+    problem = ContactProblem(
+        V, Material(E, nu), [sym], facet_tags=scene.facet_tags, interface=ci,
+        prescribed=[PrescribedDisplacement(bottom, (0.0, 0.0, delta), (2,), channel="normal"),
+                    PrescribedDisplacement(bottom, (slide, 0.0, 0.0), (0,), channel="shear")],
+        programs=prog.channels)
+    solver = SNESSolver(problem, prefix="mindlin_")
+    rows = []
+    for inc in load_path(problem, solver, prog.times, verbose=verbose):
+        R = problem.reaction(bottom)
+        pf = ci.point_fields()
+        # contact: p above 1e-3 of the peak (the softplus law is positive everywhere; Hertz's
+        # p reaches 1e-3 p0 within 5e-7 a of the edge)
+        p_max = comm.allreduce(float(pf.pressure.max(initial=0.0)), op=MPI.MAX)
+        touching = pf.pressure > 1e-3 * p_max
+        A_c, A_s = comm.allreduce(np.array([pf.weight[touching].sum(),
+                                            pf.weight[touching & pf.slipping].sum()]),
+                                  op=MPI.SUM)
+        stick = float(np.sqrt(max(1.0 - A_s / A_c, 0.0))) if A_c > 0 else float("nan")
+        rows.append((inc.load_factor, problem.scales["shear"] * slide, 2.0 * R[2], 2.0 * R[0],
+                     stick, 2.0 * A_c, 2.0 * inc.dissipation, inc.newton_total))
+    solver.destroy()
+    t, s, P, Q, stick, area, D, newton = (np.array(c) for c in zip(*rows))
+    a = (3.0 * P[-1] * radius / (4.0 * E_star)) ** (1.0 / 3.0)
+    return dict(t=t, slide=s, P=P, Q=Q, stick=stick, contact_area=area, dissipation=D,
+                newton=newton, a=a, G=G, nu=nu, mu=mu, dofs=problem.num_dofs,
+                cycle_start=prog.cycle_start, shear_steps=shear_steps)
