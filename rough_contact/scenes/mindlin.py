@@ -52,7 +52,11 @@ __all__ = ["ParaboloidIndenter", "stick_ratio", "tangential_approach", "energy_p
 
 
 def _q(Q, mu, P) -> np.ndarray:
-    check_scalar("P", P, lo=0.0, unit="N")
+    P = np.asarray(P, dtype=float)
+    if P.ndim == 0:
+        check_scalar("P", float(P), lo=0.0, unit="N")
+    elif not np.all(np.isfinite(P) & (P > 0.0)):
+        raise ValueError(f"P = {P.min():.6g} N is invalid: it must be finite and > 0")
     check_scalar("mu", mu, lo=0.0)
     q = np.abs(np.asarray(Q, dtype=float)) / (mu * P)
     if np.any(~np.isfinite(q)) or np.any(q > 1.0):
