@@ -1,4 +1,4 @@
-"""Worker for tests/demos/test_checkpoint_kill.py (run under mpirun): the checkpoint test's
+"""Worker for tests/demos/test_multiprocess.py (run under mpirun): the checkpoint test's
 preload + cyclic rough-law program, uninterrupted ("full"), writing checkpoints ("checkpointed",
 printing each converged step and this rank's PID), or resumed from a directory ("resume").
 Writes the final figures as JSON (rank 0). Usage: checkpoint_worker.py MODE DIR OUT.json"""

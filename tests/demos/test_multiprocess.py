@@ -1,4 +1,6 @@
-"""A rank killed with SIGKILL during a checkpointed run: the run resumed from the checkpoint
+"""Multi-process runs driven from a serial test.
+
+(1) A rank killed with SIGKILL during a checkpointed run: the run resumed from the checkpoint
 directory ends exactly where the uninterrupted run ends (issue 10: "SIGKILL at any moment never
 corrupts the last checkpoint").
 
@@ -7,7 +9,11 @@ slip hardening) writing a checkpoint at every converged increment; once a given 
 reported, rank 1 is killed with SIGKILL (so the kill lands wherever that rank is: solving the
 next increment or writing its checkpoint; the test is repeated at three steps). A fresh 2-rank run
 resumes from the directory; its final dissipation, contact force and displacement norm equal the
-uninterrupted run's to 1e-12 relative. Runs the workers with mpirun; skipped without it.
+uninterrupted run's to 1e-12 relative.
+
+(2) The non-matching pairings' rank-independence test on 3 ranks (issue 9: 1 = 2 = 3 ranks).
+
+Runs the workers with mpirun; skipped without it.
 """
 
 from __future__ import annotations
@@ -67,3 +73,14 @@ def test_sigkill_then_resume(tmp_path):
             assert resumed[key] == pytest.approx(reference[key], rel=1e-12), key
         np.testing.assert_allclose(resumed["F"], reference["F"], rtol=1e-12,
                                    atol=1e-12 * np.abs(reference["F"]).max())
+
+
+@pytest.mark.skipif(MPIRUN is None, reason="needs mpirun")
+def test_nonmatching_pairings_on_three_ranks():
+    """Issue 9 asks 1 = 2 = 3 ranks: the rank-independence test of the non-matching pairings
+    (COMM_WORLD figures against COMM_SELF ones, 1e-10) on 3 ranks (2 cores: oversubscribed)."""
+    test = Path(__file__).parents[1] / "fem" / "test_nonmatching.py"
+    cmd = [MPIRUN, "-n", "3", "--oversubscribe", sys.executable, "-m", "pytest", "-q",
+           "-p", "no:cacheprovider", str(test), "-k", "rank_independent"]
+    proc = subprocess.run(cmd, env=ENV, capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-2000:]
