@@ -471,6 +471,86 @@ def scene_from_gmsh(model, comm: MPI.Comm, *, split_body: str,
             raise ValueError(f"rigid_plane normal {normal} has zero length; must be nonzero")
         rigid_plane = (point, normal / norm)
     data = _on_rank(comm, rank, lambda: _read_model(model, split_body, surface_owners))
+    return _scene_from_data(data, comm, contact_pair=contact_pair, rigid_plane=rigid_plane,
+                            rank=rank, dimensions=dimensions)
+
+
+def _merge_models(parts: list) -> dict:
+    """Concatenate the arrays of several gmsh models (separate meshes: nothing shared)."""
+    labels, bodies = {}, []
+    for part in parts:
+        clash = set(labels) & set(part["labels"])
+        tags = set(labels.values()) & set(part["labels"].values())
+        if clash or tags:
+            raise ValueError(f"the mesh files share physical group names {sorted(clash)} or "
+                             f"tags {sorted(tags)}: every group of the combined scene must have "
+                             "its own name and tag")
+        labels.update(part["labels"])
+        bodies += list(part["bodies"])
+    types = {p["cell_type"] for p in parts}
+    if len(types) != 1:
+        raise ValueError(f"the mesh files hold different cell types (gmsh types {sorted(types)}): "
+                         "all bodies must use the same element")
+    offsets = np.cumsum([0] + [len(p["x"]) for p in parts[:-1]])
+    return dict(x=np.vstack([p["x"] for p in parts]),
+                cells=np.vstack([p["cells"] + o for p, o in zip(parts, offsets)]),
+                cell_values=np.concatenate([p["cell_values"] for p in parts]),
+                facets=np.vstack([p["facets"] + o for p, o in zip(parts, offsets)]),
+                facet_values=np.concatenate([p["facet_values"] for p in parts]),
+                cell_type=parts[0]["cell_type"], labels=labels, bodies=tuple(bodies),
+                n_shared=sum(p["n_shared"] for p in parts),
+                n_facet_nodes=parts[0]["n_facet_nodes"])
+
+
+def scene_from_msh_files(paths: typing.Sequence, comm: MPI.Comm, *, contact_pair: tuple,
+                         split_bodies: typing.Optional[typing.Sequence[str]] = None,
+                         rigid_plane: typing.Optional[tuple] = None, rank: int = 0,
+                         dimensions: typing.Optional[dict] = None) -> Scene:
+    """One scene from several gmsh ``.msh`` files meshed separately (e.g. a flange and a
+    gasket), for a non-matching interface. Collective.
+
+    Each file is read in its own gmsh model (so node, element and entity numbers of different
+    files never clash) and must name its physical groups (bodies: dimension 3, surfaces:
+    dimension 2) with names and tags not used by the other files; the arrays are concatenated
+    and distributed as for :func:`scene_from_gmsh`.
+
+    Args:
+        paths: the ``.msh`` files.
+        contact_pair: (first contact surface name, second name) — typically one from each file.
+        split_bodies: per file, the body whose nodes shared with its other bodies are duplicated
+            (a file with one body needs none: default, its first body).
+
+    Raises:
+        ValueError: a missing file, clashing group names/tags, different cell types.
+    """
+    import os
+
+    paths = [os.fspath(p) for p in paths]
+
+    def read():
+        import gmsh
+
+        parts = []
+        for i, path in enumerate(paths):
+            if not os.path.isfile(path):
+                raise ValueError(f"mesh file {path!r} does not exist")
+            gmsh.model.add(f"part{i}")
+            gmsh.merge(path)
+            split = None if split_bodies is None else split_bodies[i]
+            if split is None:
+                split = next(iter(_gmsh_groups(gmsh.model, 3)), None)
+            parts.append(_read_model(gmsh.model, split, None))
+            gmsh.model.remove()
+        return _merge_models(parts)
+
+    with gmsh_session(comm, rank, "msh_files"):
+        data = _on_rank(comm, rank, read)
+    return _scene_from_data(data, comm, contact_pair=contact_pair, rigid_plane=rigid_plane,
+                            rank=rank, dimensions=dimensions)
+
+
+def _scene_from_data(data, comm, *, contact_pair, rigid_plane, rank, dimensions) -> Scene:
+    """Distribute the arrays read by :func:`_read_model` (on ``rank``; None elsewhere)."""
     meta = comm.bcast(None if data is None else
                       {k: data[k] for k in ("cell_type", "labels", "n_facet_nodes", "bodies")},
                       root=rank)

@@ -214,3 +214,70 @@ def test_errors():
     # auto falls back to the projection
     ci = ContactInterface(V, scene.facet_tags, upper, lower, law=law)
     assert ci.pairing_used == "projection"
+
+
+def _write_block_msh(path, z0, height, size, prefix, body_tag, tag0):
+    """A block [0, 1]^2 x [z0, z0 + height] as its own .msh file (gmsh, rank 0 only)."""
+    import gmsh
+
+    gmsh.initialize()
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.model.add(prefix)
+        box = gmsh.model.occ.addBox(0, 0, z0, 1, 1, height)
+        gmsh.model.occ.synchronize()
+        gmsh.model.addPhysicalGroup(3, [box], body_tag)
+        gmsh.model.setPhysicalName(3, body_tag, prefix)
+        names = {"bottom": lambda c: abs(c[2] - z0) < 1e-9,
+                 "top": lambda c: abs(c[2] - z0 - height) < 1e-9,
+                 "x0": lambda c: abs(c[0]) < 1e-9, "y0": lambda c: abs(c[1]) < 1e-9}
+        for k, (name, sel) in enumerate(names.items()):
+            faces = [t for _, t in gmsh.model.getEntities(2)
+                     if sel(gmsh.model.occ.getCenterOfMass(2, t))]
+            gmsh.model.addPhysicalGroup(2, faces, tag0 + k)
+            gmsh.model.setPhysicalName(2, tag0 + k, f"{prefix}_{name}")
+        gmsh.option.setNumber("Mesh.MeshSizeMax", size)
+        gmsh.model.mesh.generate(3)
+        gmsh.write(str(path))
+    finally:
+        gmsh.finalize()
+
+
+def test_two_msh_files_make_one_scene(tmp_path):
+    """Two blocks meshed in two .msh files (sizes 0.2 and 0.28) make one scene; the mortar
+    pairing between them transmits a uniform pressure exactly (patch test)."""
+    from rough_contact.fem.mesh import scene_from_msh_files
+
+    comm = MPI.COMM_WORLD
+    folder = comm.bcast(str(tmp_path), root=0)
+    lower, upper = f"{folder}/lower.msh", f"{folder}/upper.msh"
+    if comm.rank == 0:
+        _write_block_msh(lower, -1.0, 1.0, 0.2, "lower", 2, 20)
+        _write_block_msh(upper, 0.0, 0.5, 0.28, "upper", 1, 10)
+    comm.Barrier()
+    scene = scene_from_msh_files([lower, upper], comm,
+                                 contact_pair=("upper_bottom", "lower_top"))
+    V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", 1))
+    bcs = [roller(V, scene, f"{b}_{s}", c) for b in ("lower", "upper")
+           for s, c in (("x0", 0), ("y0", 1))] + [roller(V, scene, "lower_bottom", 2)]
+    ci = ContactInterface(V, scene.facet_tags, *scene.contact_pair, law=LinearPenalty(1e6),
+                          bcs=bcs, pairing="mortar")
+    mats = {scene.tag("upper"): Material(E, NU), scene.tag("lower"): Material(0.5 * E, NU)}
+    problem = ContactProblem(V, mats, bcs, [SurfaceLoad(scene.tag("upper_top"),
+                                                        traction=[0, 0, -80.0])],
+                             cell_tags=scene.cell_tags, facet_tags=scene.facet_tags,
+                             interface=ci)
+    solver = SNESSolver(problem, prefix="test_msh_files_")
+    problem.set_load_factor(1.0)
+    assert solver.solve().converged
+    ci.evaluate(problem.u)
+    pf = ci.point_fields()
+    real = pf.weight > 0
+    err = comm.allreduce(float(np.abs(pf.pressure[real] - 80.0).max(initial=0.0)), op=MPI.MAX)
+    assert err <= 1e-8 * 80.0
+    solver.destroy()
+    with pytest.raises(ValueError, match="share physical group names"):
+        scene_from_msh_files([lower, lower], comm, contact_pair=("lower_top", "lower_top"))
+    with pytest.raises(ValueError, match="does not exist"):
+        scene_from_msh_files([lower, f"{folder}/nothing.msh"], comm,
+                             contact_pair=("lower_top", "x"))
