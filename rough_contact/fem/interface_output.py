@@ -189,9 +189,13 @@ def _check_points(weights: np.ndarray, n_qp: int) -> np.ndarray:
         raise ValueError(f"n_qp = {n_qp!r} must be an integer >= 1")
     if w.ndim != 1 or w.size % n_qp:
         raise ValueError(f"weights of shape {w.shape} must be (n_facets * n_qp,), n_qp = {n_qp}")
-    if np.any(~np.isfinite(w)) or np.any(w <= 0.0):
-        raise ValueError(f"quadrature weights must be finite and > 0, min = {w.min(initial=0)}")
-    return w.reshape(-1, n_qp)
+    if np.any(~np.isfinite(w)) or np.any(w < 0.0):
+        raise ValueError(f"quadrature weights must be finite and >= 0, min = {w.min(initial=0)}")
+    w = w.reshape(-1, n_qp)
+    if np.any(w.sum(axis=1) <= 0.0):   # weight-0 points fill the mortar pairing's slots
+        raise ValueError("every facet needs a positive total quadrature weight; "
+                         f"{int(np.sum(w.sum(axis=1) <= 0.0))} facets have none")
+    return w
 
 
 def facet_average(values: np.ndarray, weights: np.ndarray, n_qp: int) -> np.ndarray:
@@ -199,7 +203,8 @@ def facet_average(values: np.ndarray, weights: np.ndarray, n_qp: int) -> np.ndar
 
     Args:
         values: (n_f * n_qp, ...) point values; points of facet f are f*n_qp ... f*n_qp+n_qp-1.
-        weights: (n_f * n_qp,) quadrature weights [mm^2], > 0.
+        weights: (n_f * n_qp,) quadrature weights [mm^2], >= 0 with a positive sum per facet
+            (the mortar pairing fills its slots with weight-0 copies).
         n_qp: points per facet.
 
     Returns:

@@ -434,8 +434,13 @@ def test_facet_average_is_weighted_mean():
     v = np.array([[4.0, 1.0], [0.0, 1.0], [1.0, 0.0], [3.0, 2.0]])
     assert np.allclose(facet_average(v, w, 2), [[1.0, 1.0], [2.0, 1.0]])
     assert np.allclose(facet_average(v[:, 0], w, 2), [1.0, 2.0])
+    # a weight-0 point (the mortar pairing's slot copies) does not count
+    assert np.allclose(facet_average(v, np.array([1.0, 0.0, 1.0, 1.0]), 2),
+                       [[4.0, 1.0], [2.0, 1.0]])
     with pytest.raises(ValueError, match="weights"):
-        facet_average(v, np.array([1.0, 0.0, 1.0, 1.0]), 2)
+        facet_average(v, np.array([1.0, -1.0, 1.0, 1.0]), 2)
+    with pytest.raises(ValueError, match="positive total quadrature weight"):
+        facet_average(v, np.array([0.0, 0.0, 1.0, 1.0]), 2)
     with pytest.raises(ValueError, match="n_qp"):
         facet_average(v, w, 3)
 

@@ -27,6 +27,7 @@ from petsc4py import PETSc
 import dolfinx
 from dolfinx import fem
 from rough_contact.fem.contact import ContactInterface
+from rough_contact.fem.interface_output import facet_output
 from rough_contact.fem.problem import ContactProblem, Material, SurfaceLoad
 from rough_contact.interface.penalty import LinearPenalty, SoftplusPenalty
 from rough_contact.scenes.meshes.blocks import separate_blocks
@@ -72,6 +73,10 @@ def patch(cell_type, order, size_lower, size_upper, first, pairing, law, E_lower
     slipping = c.allreduce(int(pf.slipping[real].sum()), op=MPI.SUM)
     force = ci.contact_force()
     summary = ci.summary()
+    facets = facet_output(ci)          # what the XDMF writer writes per facet
+    f_err = c.allreduce(float(np.max(np.abs(facets.pressure - p), initial=0.0)), op=MPI.MAX)
+    assert f_err <= 1e-8 * p
+    assert abs(c.allreduce(float(facets.area.sum()), op=MPI.SUM) - 1.0) <= 1e-10
     solver.destroy()
     return p_err / p, s_err / p, force, summary, slipping
 
@@ -91,7 +96,8 @@ CASES = [  # cell type, order, lower size, upper size, first surface
                          f"{c[2]:.3g}:{c[3]:.3g}-{c[4]}")
 def test_mortar_patch_frictionless(case):
     """Uniform pressure crosses a non-matching interface exactly (different block stiffness:
-    the blocks slide laterally against each other, the law carries no shear)."""
+    the blocks slide laterally against each other, the law carries no shear); the facet
+    output (quadrature averages, weight-0 slot copies included) shows it too."""
     p_err, s_err, force, summary, _ = patch(*case, "mortar", LinearPenalty(1e6), 0.5 * E)
     assert p_err <= 1e-8
     assert abs(force[2] / 80.0 - (1.0 if case[4] == "upper" else -1.0)) <= 1e-10
