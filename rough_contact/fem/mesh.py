@@ -771,6 +771,17 @@ def scene_cli(builder, float_options, argv=None, description=None) -> Scene:
     return scene
 
 
+def generate(model, order: int) -> None:
+    """Mesh the model in 3D and, for ``order`` 2, make it second order (complete 10-node
+    tetrahedra / 27-node hexahedra)."""
+    import gmsh
+
+    model.mesh.generate(3)
+    if order == 2:
+        gmsh.option.setNumber("Mesh.SecondOrderIncomplete", 0)
+        model.mesh.setOrder(2)
+
+
 def refine_towards(model, distance: str, contact_size: float, mesh_size: float,
                    transition: float) -> None:
     """Element size from ``contact_size`` at distance 0 to ``mesh_size`` beyond ``transition``.

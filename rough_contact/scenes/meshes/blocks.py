@@ -37,7 +37,7 @@ import numpy as np
 from mpi4py import MPI
 
 from rough_contact.fem.mesh import (Scene, add_groups, build_scene, entity_centers,
-                                    refine_towards,
+                                    generate, refine_towards,
                                     set_transfinite_hexahedra, validate_cell_type,
                                     validate_order, validate_positive)
 
@@ -62,10 +62,7 @@ def _mesh(model, mesh_size, order, cell_type):
     else:
         gmsh.option.setNumber("Mesh.MeshSizeMax", mesh_size)
         gmsh.option.setNumber("Mesh.MeshSizeMin", 0.1 * mesh_size)
-    model.mesh.generate(3)
-    if order == 2:
-        gmsh.option.setNumber("Mesh.SecondOrderIncomplete", 0)
-        model.mesh.setOrder(2)
+    generate(model, order)
 
 
 def two_blocks(lx: float = 1.0, ly: float = 1.0, h1: float = 1.0, h2: float = 1.0,
@@ -179,10 +176,7 @@ def separate_blocks(lx: float = 1.0, ly: float = 1.0, h1: float = 1.0, h2: float
                 model.mesh.setTransfiniteVolume(volume)
         else:
             gmsh.option.setNumber("Mesh.MeshSizeMax", max(size_lower, size_upper))
-        model.mesh.generate(3)
-        if order == 2:
-            gmsh.option.setNumber("Mesh.SecondOrderIncomplete", 0)
-            model.mesh.setOrder(2)
+        generate(model, order)
 
     return build_scene(
         comm, "separate_blocks", build, split_body="upper",
@@ -289,10 +283,7 @@ def sphere_on_block(radius: float = 10.0, cap_height: float = 1.0, half_width: f
         gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
         gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
         gmsh.option.setNumber("Mesh.MeshSizeMax", mesh_size)
-        model.mesh.generate(3)
-        if order == 2:
-            gmsh.option.setNumber("Mesh.SecondOrderIncomplete", 0)
-            model.mesh.setOrder(2)
+        generate(model, order)
 
     return build_scene(
         comm, "sphere_on_block", build, split_body="sphere",
@@ -351,10 +342,7 @@ def cylinder_on_block(radius: float = 5.0, height: float = 5.0, half_width: floa
             points = model.getBoundary([(3, vol)], recursive=True)
             model.mesh.setSize(points, size)
         gmsh.option.setNumber("Mesh.MeshSizeMax", max(size_cylinder, size_block))
-        model.mesh.generate(3)
-        if order == 2:
-            gmsh.option.setNumber("Mesh.SecondOrderIncomplete", 0)
-            model.mesh.setOrder(2)
+        generate(model, order)
 
     return build_scene(
         comm, "cylinder_on_block", build, split_body="cylinder",
@@ -436,12 +424,7 @@ def indented_block(half_width: float = 4.0, height: float = 4.0, mesh_size: floa
         r = "Sqrt(x^2+y^2+z^2)"
         refine_towards(model, f"(Abs({r}-{refined_radius})+{r}-{refined_radius})/2",
                        contact_size, mesh_size, transition)
-        model.mesh.generate(3)
-        if order == 2:
-            import gmsh
-
-            gmsh.option.setNumber("Mesh.SecondOrderIncomplete", 0)
-            model.mesh.setOrder(2)
+        generate(model, order)
 
     return build_scene(
         comm, "indented_block", build, split_body="block", contact_pair=("contact", None),
