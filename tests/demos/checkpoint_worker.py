@@ -6,41 +6,23 @@ Writes the final figures as JSON (rank 0). Usage: checkpoint_worker.py MODE DIR 
 import json
 import os
 import sys
+from pathlib import Path
 
 import numpy as np
 from mpi4py import MPI
-from petsc4py import PETSc
 
-from dolfinx import fem
-from rough_contact.fem.contact import ContactInterface
-from rough_contact.fem.problem import (ContactProblem, Material, PrescribedDisplacement,
-                                       SurfaceLoad)
-from rough_contact.scenes import flat_punch
-from rough_contact.scenes.meshes.blocks import two_blocks
-from rough_contact.solver.loading import load_path
-from rough_contact.solver.program import preload_then_cyclic
-from rough_contact.solver.snes import SNESSolver
+sys.path.insert(0, str(Path(__file__).parents[1] / "fem"))
+import test_checkpoint  # noqa: E402  (the checkpoint test's model, with a longer program)
 
-PROGRAM = preload_then_cyclic(preload_steps=2, cycles=2, steps_per_cycle=8)
+from rough_contact.solver.loading import load_path  # noqa: E402
+from rough_contact.solver.program import preload_then_cyclic  # noqa: E402
+
+PROGRAM = test_checkpoint.PROGRAM = preload_then_cyclic(preload_steps=2, cycles=2,
+                                                        steps_per_cycle=8)
 
 
 def model():
-    comm = MPI.COMM_WORLD
-    scene = two_blocks(lx=2.0, ly=2.0, h1=1.0, h2=1.0, mesh_size=0.5, order=1)
-    V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", 1))
-    clamp = fem.dirichletbc(np.zeros(3, dtype=PETSc.ScalarType), fem.locate_dofs_topological(
-        V, 2, scene.facet_tags.find(scene.tag("bottom"))), V)
-    law, _ = flat_punch.make_law(comm, case="b", normal_law="elastic", seating_pressure=5.0)
-    first, second = scene.contact_pair
-    ci = ContactInterface(V, scene.facet_tags, first, second, law=law, bcs=[clamp])
-    top = scene.tag("top")
-    problem = ContactProblem(
-        V, Material(flat_punch.E, flat_punch.NU), [clamp],
-        [SurfaceLoad(top, force=(0.0, 0.0, -40.0), channel="preload")],
-        facet_tags=scene.facet_tags, interface=ci, seating_tag=first, seating_stiffness=1e3,
-        prescribed=[PrescribedDisplacement(top, (2e-3, 0.0, 0.0), (0,), channel="cyclic")],
-        programs=PROGRAM.channels)
-    return problem, SNESSolver(problem, prefix="ck_")
+    return test_checkpoint._model()
 
 
 def main(mode, directory, out):
