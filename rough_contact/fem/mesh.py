@@ -783,26 +783,48 @@ def generate(model, order: int) -> None:
 
 
 def refine_towards(model, distance: str, contact_size: float, mesh_size: float,
-                   transition: float) -> None:
+                   transition: float, regions: typing.Optional[typing.Sequence] = None) -> None:
     """Element size from ``contact_size`` at distance 0 to ``mesh_size`` beyond ``transition``.
 
     Args:
         model: ``gmsh.model``.
         distance: gmsh MathEval expression in x, y, z of the exact distance to the contact
             region [mm] (exact, unlike gmsh's sampled Distance field).
+        regions: optional ``[(volume tags, contact size), ...]``: a size field per group of
+            volumes (restricted to them, their faces and curves), the smallest size winning —
+            bodies meshed separately with their own sizes at the contact.
     """
     import gmsh
 
     field = model.mesh.field
-    dist = field.add("MathEval")
-    field.setString(dist, "F", distance)
-    thr = field.add("Threshold")
-    field.setNumber(thr, "InField", dist)
-    field.setNumber(thr, "SizeMin", contact_size)
-    field.setNumber(thr, "SizeMax", mesh_size)
-    field.setNumber(thr, "DistMin", 0.0)
-    field.setNumber(thr, "DistMax", transition)
-    field.setAsBackgroundMesh(thr)
+
+    def threshold(size):
+        dist = field.add("MathEval")
+        field.setString(dist, "F", distance)
+        thr = field.add("Threshold")
+        field.setNumber(thr, "InField", dist)
+        field.setNumber(thr, "SizeMin", size)
+        field.setNumber(thr, "SizeMax", mesh_size)
+        field.setNumber(thr, "DistMin", 0.0)
+        field.setNumber(thr, "DistMax", transition)
+        return thr
+
+    if regions is None:
+        field.setAsBackgroundMesh(threshold(contact_size))
+    else:
+        restricted = []
+        for vols, size in regions:
+            res = field.add("Restrict")
+            field.setNumber(res, "InField", threshold(size))
+            faces = model.getBoundary([(3, v) for v in vols], combined=False, oriented=False)
+            curves = model.getBoundary(faces, combined=False, oriented=False)
+            field.setNumbers(res, "VolumesList", list(vols))
+            field.setNumbers(res, "SurfacesList", sorted({abs(t) for _, t in faces}))
+            field.setNumbers(res, "CurvesList", sorted({abs(t) for _, t in curves}))
+            restricted.append(res)
+        smallest = field.add("Min")
+        field.setNumbers(smallest, "FieldsList", restricted)
+        field.setAsBackgroundMesh(smallest)
     gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
     gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
     gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)

@@ -224,8 +224,6 @@ def sphere_on_block(radius: float = 10.0, cap_height: float = 1.0, half_width: f
     tol = 1e-6 * max(radius, half_width, height)
 
     def build(model):
-        import gmsh
-
         occ = model.occ
         ball = occ.addSphere(0, 0, radius, radius)
         box = occ.addBox(0, 0, 0, base * 1.1, base * 1.1, cap_height)
@@ -257,32 +255,10 @@ def sphere_on_block(radius: float = 10.0, cap_height: float = 1.0, half_width: f
             "symmetry_y": (18, tags[np.abs(c[:, 1]) < tol])})
         # one size field per body (restricted to its volumes), the smaller one wins
         dist = "Sqrt(x^2+y^2+z^2)"
-        field = model.mesh.field
-        fields = []
-        for vols, size in ((sphere_vols, size_ratio * contact_size), ([block], contact_size)):
-            f = field.add("MathEval")
-            field.setString(f, "F", f"(Abs({dist}-{refined_radius})+{dist}-{refined_radius})/2")
-            thr = field.add("Threshold")
-            field.setNumber(thr, "InField", f)
-            field.setNumber(thr, "SizeMin", size)
-            field.setNumber(thr, "SizeMax", mesh_size)
-            field.setNumber(thr, "DistMin", 0.0)
-            field.setNumber(thr, "DistMax", transition)
-            res = field.add("Restrict")
-            field.setNumber(res, "InField", thr)
-            faces = model.getBoundary([(3, v) for v in vols], combined=False, oriented=False)
-            curves = model.getBoundary(faces, combined=False, oriented=False)
-            field.setNumbers(res, "VolumesList", vols)
-            field.setNumbers(res, "SurfacesList", sorted({abs(t) for _, t in faces}))
-            field.setNumbers(res, "CurvesList", sorted({abs(t) for _, t in curves}))
-            fields.append(res)
-        fmin = field.add("Min")
-        field.setNumbers(fmin, "FieldsList", fields)
-        field.setAsBackgroundMesh(fmin)
-        gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
-        gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
-        gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
-        gmsh.option.setNumber("Mesh.MeshSizeMax", mesh_size)
+        refine_towards(model, f"(Abs({dist}-{refined_radius})+{dist}-{refined_radius})/2",
+                       contact_size, mesh_size, transition,
+                       regions=[(sphere_vols, size_ratio * contact_size),
+                                ([block], contact_size)])
         generate(model, order)
 
     return build_scene(
