@@ -104,10 +104,11 @@ def _compare_with_hertz(comm, ci: ContactInterface, P: float, E_star: float,
 
 def run_elastic(contact_size=0.04, order=2, radius=10.0, approach=6e-3, E=2.0e5, nu=0.3,
                 size_ratio=0.7, penalty=1e8, steps=2, pairing="mortar", mesh_size=1.0,
-                comm=MPI.COMM_WORLD) -> dict:
+                quadrature="gauss", comm=MPI.COMM_WORLD) -> dict:
     """An elastic sphere (same material as the block) meshed independently of the block,
     pressed by moving its top down by ``approach`` [mm]; frictionless stiff penalty across the
-    non-matching interface (``pairing``: "mortar" or "projection"). Hertz with
+    non-matching interface (``pairing``: "mortar" or "projection"; ``quadrature="vertex"``
+    with the projection and P1: node-to-surface). Hertz with
     1/E* = 2 (1 - nu^2) / E and the sphere's radius (the block is flat). Collective.
 
     Returns:
@@ -129,7 +130,8 @@ def run_elastic(contact_size=0.04, order=2, radius=10.0, approach=6e-3, E=2.0e5,
            fem.dirichletbc(zero, dofs("symmetry_y", 1), V.sub(1))]
     ci = ContactInterface(V, scene.facet_tags, *scene.contact_pair,
                           law=LinearPenalty(penalty, unilateral=True), bcs=bcs,
-                          quadrature_degree=2 * order, pairing=pairing, search_radius=0.2)
+                          quadrature_degree=2 * order, pairing=pairing, search_radius=0.2,
+                          quadrature=quadrature)
     top = scene.tag("sphere_top")
     problem = ContactProblem(V, Material(E, nu), bcs, facet_tags=scene.facet_tags,
                              interface=ci, prescribed=[
@@ -146,5 +148,5 @@ def run_elastic(contact_size=0.04, order=2, radius=10.0, approach=6e-3, E=2.0e5,
     solver.destroy()
     if out is not None:
         out.update(dofs=problem.num_dofs, contact_size=contact_size, order=order,
-                   pairing=pairing, balance=abs(P - P_bottom) / P)
+                   pairing=pairing, quadrature=quadrature, balance=abs(P - P_bottom) / P)
     return comm.bcast(out, root=0)
