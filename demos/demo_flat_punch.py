@@ -73,6 +73,9 @@ def parse_args(argv):
     parser.add_argument("--restart", default=None, metavar="DIR",
                         help="continue a stopped run from its checkpoint DIR (same options and "
                              "number of ranks)")
+    parser.add_argument("--stop-after", type=int, default=None, metavar="N",
+                        help="stop after N increments (their checkpoint written: use with "
+                             "--checkpoint, continue with --restart)")
     parser.add_argument("--validity", default="warn", choices=["warn", "error", "ignore"],
                         help="interface points beyond the normal law's validity in a converged "
                              "increment: warn (default), stop with an error, or only count them")
@@ -110,5 +113,5 @@ if __name__ == "__main__":
         load_half_width=args.load_half_width, steps=args.steps, unload=not args.no_unload,
         law=args.law, case=args.case, normal_law=args.normal_law, outdir=args.outdir,
         dof_threshold=args.dof_threshold, overwrite=True, validity=args.validity,
-        checkpoint=args.checkpoint, restart=args.restart)
+        checkpoint=args.checkpoint, restart=args.restart, stop_after=args.stop_after)
 

@@ -2,10 +2,11 @@
 
     bash run.sh python demos/demo_fretting.py [--amplitudes 0.3 0.5 0.7 1 2 4] [--cycles 2]
         [--steps-per-cycle 16] [--pressure 10] [--mesh-size 0.5] [--order 1] [--outdir DIR]
+        [--checkpoint CKDIR | --restart CKDIR]
     mpirun -n 2 .venv/bin/python demos/demo_fretting.py
 
 Writes DIR/cycles.csv (per amplitude and cycle: loop energy, interface dissipation, secant
-stiffness), DIR/fretting.png (loops; energy per cycle vs amplitude, log-log) and
+stiffness), DIR/loop_a<amplitude>um.csv (per increment: u_x, F_x, dissipation), DIR/fretting.png (loops; energy per cycle vs amplitude, log-log) and
 DIR/loop_largest.png. The library function is rough_contact.scenes.fretting.run.
 """
 
@@ -24,10 +25,17 @@ def main(argv=None):
     ap.add_argument("--mesh-size", type=float, default=0.5, help="element size [mm]")
     ap.add_argument("--order", type=int, default=1, choices=[1, 2])
     ap.add_argument("--outdir", default="results/fretting")
+    ck = ap.add_mutually_exclusive_group()
+    ck.add_argument("--checkpoint", default=None, metavar="CKDIR",
+                    help="write a checkpoint after every converged increment into CKDIR")
+    ck.add_argument("--restart", default=None, metavar="CKDIR",
+                    help="continue a stopped run (same options and ranks) from CKDIR: finished "
+                    "amplitudes are read back, the interrupted one continues")
     args = ap.parse_args(argv)
     fretting.run(args.amplitudes, outdir=args.outdir, cycles=args.cycles,
                  steps_per_cycle=args.steps_per_cycle, pressure=args.pressure,
-                 mesh_size=args.mesh_size, order=args.order)
+                 mesh_size=args.mesh_size, order=args.order, checkpoint=args.checkpoint,
+                 restart=args.restart)
 
 
 if __name__ == "__main__":

@@ -51,6 +51,7 @@ from __future__ import annotations
 
 import os
 import re
+import warnings
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from typing import Any, Optional, Protocol, Sequence
@@ -498,7 +499,7 @@ class InterfaceWriter:
     """
 
     def __init__(self, outdir: str, interface: InterfaceOutputSource, *, points: bool = False,
-                 overwrite: bool = False):
+                 overwrite: bool = False, resume: bool = False):
         self.outdir = os.fspath(outdir)
         self.interface = interface
         self.comm = interface.comm
@@ -515,6 +516,14 @@ class InterfaceWriter:
 
         def create():
             os.makedirs(self.outdir, exist_ok=True)
+            # points: facet by facet in the surface's facet order, by coordinates within a facet
+            x = xq["x"].reshape(-1, n_qp, 3)[surface.order]
+            fid = np.repeat(np.arange(x.shape[0]), n_qp)
+            x = x.reshape(-1, 3)
+            within = np.lexsort((x[:, 2], x[:, 1], x[:, 0], fid))
+            self._point_order = (surface.order[:, None] * n_qp + np.arange(n_qp)).ravel()[within]
+            if resume:                # the resumed run's files: restore() trims them
+                return
             mine = _run_files(self.outdir, (re.escape(FACET_XDMF), re.escape(H5_FILE),
                                             re.escape(POINT_XDMF)))
             if mine and not overwrite:
@@ -523,24 +532,69 @@ class InterfaceWriter:
                     "overwrite=True or use prepare_output_dir")
             for f in mine:
                 os.remove(os.path.join(self.outdir, f))
-            # points: facet by facet in the surface's facet order, by coordinates within a facet
-            x = xq["x"].reshape(-1, n_qp, 3)[surface.order]
-            fid = np.repeat(np.arange(x.shape[0]), n_qp)
-            x = x.reshape(-1, 3)
-            within = np.lexsort((x[:, 2], x[:, 1], x[:, 0], fid))
-            self._point_order = (surface.order[:, None] * n_qp + np.arange(n_qp)).ravel()[within]
-            import h5py
-
-            with h5py.File(self.h5_path, "w") as h5:
-                h5["Mesh/geometry"] = surface.points
-                h5["Mesh/topology"] = surface.cells
-                if self.points:
-                    h5["Points/geometry"] = xq["x"][self._point_order]
+            self._new_h5()
             self._write_xml()
 
+        self._point_geometry = None if xq is None else xq["x"]   # rank 0 only
         self._point_order = None  # rank 0 only, like every gathered array
         self._specs: dict = {}
         _collective(self.comm, create)
+
+    def _new_h5(self) -> None:
+        import h5py
+
+        with h5py.File(self.h5_path, "w") as h5:
+            h5["Mesh/geometry"] = self.surface.points
+            h5["Mesh/topology"] = self.surface.cells
+            if self.points:
+                h5["Points/geometry"] = self._point_geometry[self._point_order]
+
+    # ------------------------------------------------------------------ restart
+    def checkpoint_state(self) -> dict:
+        """What :meth:`restore` needs to continue the files (picklable)."""
+        return dict(times=list(self.times), load_factors=list(self.load_factors),
+                    specs=dict(self._specs))
+
+    def restore(self, state: dict) -> None:
+        """Continue from :meth:`checkpoint_state` (collective): steps written after it are
+        deleted from the HDF5 file and the XML indexes rewritten; an unreadable HDF5 file (a
+        kill in the middle of its write) is moved aside as ``*.damaged`` and the series
+        restarts at the resumed step."""
+        def act():
+            import h5py
+
+            self.times = list(state["times"])
+            self.load_factors = list(state["load_factors"])
+            self._specs = dict(state["specs"])
+            n = len(self.times)
+            if not os.path.exists(self.h5_path):
+                warnings.warn(f"no earlier interface output in {self.outdir!r}: its series "
+                              "starts at the resumed step", RuntimeWarning, stacklevel=2)
+                self.times, self.load_factors = [], []
+                self._new_h5()
+                self._write_xml()
+                return self.times, self.load_factors
+            try:
+                with h5py.File(self.h5_path, "a") as h5:
+                    for group in [g for g in h5 if g.startswith("Step_")]:
+                        if int(group[5:]) > n:
+                            del h5[group]
+                    for k in range(n):
+                        h5[f"Step_{k + 1:04d}"].attrs["time"]   # raises if lost
+            except (OSError, KeyError) as exc:
+                for f in (self.h5_path, self.facet_path, self.point_path):
+                    if os.path.exists(f):
+                        os.replace(f, f + ".damaged")
+                warnings.warn(f"{self.h5_path} could not be continued ({type(exc).__name__}: "
+                              f"{exc}); moved aside as *.damaged, the interface series restarts "
+                              "at the resumed step", RuntimeWarning, stacklevel=2)
+                self.times, self.load_factors = [], []
+                self._new_h5()
+            self._write_xml()
+            return self.times, self.load_factors
+
+        self.times, self.load_factors = _collective(self.comm, act)
+        self.times, self.load_factors = list(self.times), list(self.load_factors)
 
     # ------------------------------------------------------------------ XML
     def _grid(self, k: int, mesh_items: list, items: list, center: str) -> list:

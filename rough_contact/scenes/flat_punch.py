@@ -290,7 +290,7 @@ def plot_slip_directions(comm, interface, path, title, n_grid=12):
 def run(mesh_size=20.0, contact_size=2.0, order=2, load_half_width=2.5, steps=16,
          unload=True, law="rough", case="b", normal_law="elasto-plastic", outdir="results/flat_punch",
          prefix="rc_", dof_threshold=None, comm=MPI.COMM_WORLD, verbose=True, plot=True,
-         overwrite=False, validity="warn", checkpoint=None, restart=None):
+         overwrite=False, validity="warn", checkpoint=None, restart=None, stop_after=None):
     """Run the punch; return a dict of results (identical on every rank). Collective.
 
     ``outdir`` receives one run: earlier results there make it refuse unless ``overwrite``.
@@ -298,8 +298,9 @@ def run(mesh_size=20.0, contact_size=2.0, order=2, load_half_width=2.5, steps=16
     validity does (``"warn"``, ``"error"``, ``"ignore"``; ``rough_contact.solver.loading``).
     ``checkpoint``: directory receiving a checkpoint after every converged increment;
     ``restart``: a checkpoint directory of the same run (same options and ranks) to continue
-    from (``rough_contact.solver.checkpoint``); the output folder then holds the increments of
-    the resumed part only.
+    from (``rough_contact.solver.checkpoint``); the output files in ``outdir`` (the stopped
+    run's) are cut back to the checkpoint and continued. ``stop_after``: stop after this many
+    increments (checkpoint written), to continue later with ``restart``.
     """
     t0 = MPI.Wtime()
     m = build(comm, mesh_size, contact_size, order, load_half_width, law, case, normal_law,
@@ -314,14 +315,16 @@ def run(mesh_size=20.0, contact_size=2.0, order=2, load_half_width=2.5, steps=16
     factors = load_unload_factors(steps, steps - 1 if unload else 0)
     writer = ResultWriter(outdir, comm, u=problem.u, interface=interface,
                           extra_columns=("force_error_rel",), overwrite=overwrite,
-                          extra_patterns=(r"slip_directions.*\.png",))
+                          extra_patterns=(r"slip_directions.*\.png",),
+                          resume=restart is not None)
     if writer.removed:
         PETSc.Sys.Print(f"Replaced {len(writer.removed)} files of an earlier run in {outdir}/",
                         comm=comm)
     history = []
     peak = None
     for inc in load_path(problem, solver, factors, verbose=verbose, validity=validity,
-                         checkpoint=checkpoint, resume=restart):
+                         checkpoint=checkpoint, resume=restart, outputs=[writer],
+                         max_steps=stop_after):
         # Force balance: the normal interface force on the punch equals the applied load (its
         # tangential resultant is carried by the symmetry planes of the quarter model).
         err = abs(inc.contact_force[2] + inc.applied_force[2]) / abs(inc.applied_force[2])
@@ -339,6 +342,9 @@ def run(mesh_size=20.0, contact_size=2.0, order=2, load_half_width=2.5, steps=16
         solver.destroy()
         return dict(dissipation=D, history=history, peak=None, num_dofs=problem.num_dofs,
                     n_points=n_points, max_force_error=0.0)
+    if stop_after is not None and history[-1].step < len(factors):
+        PETSc.Sys.Print(f"Stopped after {len(history)} increments (stop_after); continue with "
+                        f"restart={checkpoint!r} (--restart)", comm=comm)
     if plot:
         plot_slip_directions(comm, interface, os.path.join(outdir, "slip_directions.png"),
                              f"plastic slip directions after unloading (case {case})")

@@ -31,7 +31,9 @@ from rough_contact.fem.problem import (ContactProblem, Material, PrescribedDispl
                                        SurfaceLoad)
 from rough_contact.scenes import flat_punch
 from rough_contact.scenes.meshes.blocks import two_blocks
+from rough_contact.solver.checkpoint import has_checkpoint
 from rough_contact.solver.loading import load_path
+from rough_contact.solver.output import CsvRecorder
 from rough_contact.solver.program import cycle_summary, preload_then_cyclic
 from rough_contact.solver.snes import SNESSolver
 from rough_contact.validation import check_scalar
@@ -39,11 +41,23 @@ from rough_contact.validation import check_scalar
 __all__ = ["run_amplitude", "run"]
 
 
+LOOP_COLUMNS = ("pseudo_time", "u_x_mm", "F_x_N", "F_z_contact_N", "dissipation_Nmm",
+                "n_slipping", "n_points", "newton_its_spent")
+
+
 def run_amplitude(amplitude_um: float, *, size=2.0, height=1.0, mesh_size=0.5, order=1,
                   pressure=10.0, cycles=2, steps_per_cycle=16, preload_steps=2, normal=None,
-                  comm=MPI.COMM_WORLD, verbose=False) -> dict:
+                  comm=MPI.COMM_WORLD, verbose=False, loop_csv=None, checkpoint=None,
+                  restart=None, stop_after=None) -> dict:
     """Preload to ``pressure`` [MPa] nominal, then ``cycles`` tangential cycles of amplitude
-    ``amplitude_um`` [um]. Collective; returns identical results on every rank."""
+    ``amplitude_um`` [um]. Collective; returns identical results on every rank.
+
+    ``loop_csv``: file receiving one row per increment (``LOOP_COLUMNS``: the hysteresis loop
+    and the dissipation). ``checkpoint``: directory receiving a checkpoint per increment (with
+    the rows); ``restart``: such a directory to continue from (the rows and ``loop_csv``
+    continue); ``stop_after``: stop after this many increments (the result then covers them
+    only). ``solved`` in the result: the increments solved by this call.
+    """
     a = check_scalar("amplitude", amplitude_um, lo=0.0, unit="um") * 1e-3
     check_scalar("pressure", pressure, lo=0.0, unit="MPa")
     scene = two_blocks(lx=size, ly=size, h1=height, h2=height, mesh_size=mesh_size, order=order,
@@ -67,24 +81,39 @@ def run_amplitude(amplitude_um: float, *, size=2.0, height=1.0, mesh_size=0.5, o
         prescribed=[PrescribedDisplacement(top, (a, 0.0, 0.0), (0,), channel="cyclic")],
         programs=prog.channels)
     solver = SNESSolver(problem, prefix="fret_")
-    rows = []
-    for inc in load_path(problem, solver, prog.times, verbose=verbose):
-        rows.append((inc.load_factor, problem.scales["cyclic"] * a, problem.reaction(top)[0],
-                     inc.contact_force[2], inc.dissipation, inc.n_slipping, inc.n_points,
-                     inc.newton_total))
+    rec = CsvRecorder(loop_csv, LOOP_COLUMNS, comm)
+    solved = 0
+    for inc in load_path(problem, solver, prog.times, verbose=verbose, checkpoint=checkpoint,
+                         resume=restart, outputs=[rec], max_steps=stop_after):
+        rec.add((inc.load_factor, problem.scales["cyclic"] * a, problem.reaction(top)[0],
+                 inc.contact_force[2], inc.dissipation, inc.n_slipping, inc.n_points,
+                 inc.newton_total))
+        solved += 1
     solver.destroy()
-    t, u, fx, fz, d, slip, npts, its = (np.array(c) for c in zip(*rows))
+    t, u, fx, fz, d, slip, npts, its = rec.array().T
     return dict(amplitude_um=amplitude_um, force=force, dofs=problem.num_dofs, t=t, u=u, fx=fx,
-                fz=fz, dissipation=d, slipping=slip, n_points=npts, newton=int(its.sum()),
-                cycles=cycle_summary(t, prog, u, fx, d), normal=normal)
+                fz=fz, dissipation=d, slipping=slip.astype(int), n_points=npts.astype(int),
+                newton=int(its.sum()), cycles=cycle_summary(t, prog, u, fx, d), normal=normal,
+                solved=solved)
 
 
 def run(amplitudes_um=(0.3, 0.5, 0.7, 1.0, 2.0, 4.0), outdir="results/fretting", plot=True,
-        comm=MPI.COMM_WORLD, **kwargs) -> list:
-    """All amplitudes; writes ``cycles.csv`` (and PNGs) in ``outdir``. Collective."""
+        comm=MPI.COMM_WORLD, checkpoint=None, restart=None, **kwargs) -> list:
+    """All amplitudes; writes ``cycles.csv``, ``loop_a<amplitude>um.csv`` (per increment) and
+    PNGs in ``outdir``. Collective.
+
+    ``checkpoint``: directory receiving one checkpoint directory per amplitude; ``restart``: such
+    a directory: finished amplitudes are read back from their last checkpoint (no solve), an
+    unfinished one continues, the others run (and checkpoint into ``restart``).
+    """
     results, normal = [], None
+    if restart is not None:
+        checkpoint = restart
     for amp in amplitudes_um:
-        r = run_amplitude(amp, normal=normal, comm=comm, **kwargs)
+        ck = None if checkpoint is None else os.path.join(checkpoint, f"a{amp:g}um")
+        again = ck if restart is not None and has_checkpoint(ck, comm) else None
+        r = run_amplitude(amp, normal=normal, comm=comm, checkpoint=ck, restart=again,
+                          loop_csv=os.path.join(outdir, f"loop_a{amp:g}um.csv"), **kwargs)
         normal = r["normal"]
         last = r["cycles"][-1]
         PETSc.Sys.Print(f"  a = {amp:8.4g} um: {r['dofs']} DOFs, Newton {r['newton']}, energy per "

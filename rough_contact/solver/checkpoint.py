@@ -6,8 +6,13 @@ interface's committed law state and accumulated dissipation, the load factor, th
 the list of load factors (index, current increment size, cutbacks) and the secant predictor's
 previous state. ``load_path(..., resume=DIR)`` restores it into a freshly built problem (same
 mesh, same number of ranks, same law) and continues; the resumed run reproduces the uninterrupted
-one to round-off (tests/fem/test_checkpoint.py). The output writers are not part of the
-checkpoint: a resumed run writes its own output folder from the resumed increment on.
+one to round-off (tests/fem/test_checkpoint.py).
+
+Output writers given as ``load_path(..., outputs=[...])`` (:class:`ResumableOutput`, e.g.
+``ResultWriter``) are part of the checkpoint: the checkpoint of increment k is written when the
+caller's loop asks for increment k + 1, i.e. after the loop body has written k's output, and
+holds each writer's state; on resume every writer is restored to it, so the resumed run
+continues the same files (``rough_contact.solver.output``).
 
 Atomicity: two slots ``slot0/`` and ``slot1/`` are written alternately (one ``rank<r>.pkl`` per
 rank, then ``meta.json``); the file ``LATEST`` naming the complete slot is replaced atomically
@@ -25,17 +30,28 @@ import json
 import os
 import pickle
 from dataclasses import dataclass
-from typing import Optional
+from typing import Optional, Protocol, Sequence, runtime_checkable
 
 import numpy as np
 from mpi4py import MPI
 
-__all__ = ["CheckpointState", "CheckpointError", "signature", "write_checkpoint",
+__all__ = ["ResumableOutput", "CheckpointState", "has_checkpoint", "CheckpointError", "signature", "write_checkpoint",
            "read_checkpoint"]
 
 
 class CheckpointError(ValueError):
     """A checkpoint that cannot be resumed into this problem (the message says why)."""
+
+
+@runtime_checkable
+class ResumableOutput(Protocol):
+    """An output writer whose files a resumed run continues."""
+
+    def checkpoint_state(self) -> object:
+        """This rank's state after the last written increment (picklable)."""
+
+    def restore(self, state: object) -> None:
+        """Continue from ``state`` (collective): trim the files back to it."""
 
 
 @dataclass
@@ -65,9 +81,11 @@ def signature(problem) -> dict:
         n_points=0 if ci is None else int(ci.n_points_global))
 
 
-def write_checkpoint(directory: str, problem, state: CheckpointState, sig: dict) -> None:
+def write_checkpoint(directory: str, problem, state: CheckpointState, sig: dict,
+                     outputs: Sequence[ResumableOutput] = ()) -> None:
     """Write one checkpoint (collective); ``sig`` = :func:`signature` of the problem (computed
-    once). See the module for the layout and atomicity."""
+    once), ``outputs`` the writers whose state is saved with it. See the module for the layout
+    and atomicity."""
     comm = problem.comm
     if comm.rank == 0:
         os.makedirs(directory, exist_ok=True)
@@ -83,7 +101,8 @@ def write_checkpoint(directory: str, problem, state: CheckpointState, sig: dict)
     ci = problem.interface
     data = dict(u=problem.u.x.array.copy(), u_previous=state.u_previous,
                 committed=None if ci is None else ci.history.committed,
-                dissipated=None if ci is None else ci.history.dissipated)
+                dissipated=None if ci is None else ci.history.dissipated,
+                outputs=[o.checkpoint_state() for o in outputs])
     with open(os.path.join(path, f"rank{comm.rank}.pkl"), "wb") as f:
         pickle.dump(data, f, protocol=pickle.HIGHEST_PROTOCOL)
         f.flush()
@@ -106,6 +125,11 @@ def write_checkpoint(directory: str, problem, state: CheckpointState, sig: dict)
     comm.Barrier()
 
 
+def has_checkpoint(directory: str, comm: MPI.Comm = MPI.COMM_WORLD) -> bool:
+    """Whether ``directory`` holds a complete checkpoint (collective: rank 0 decides)."""
+    return bool(comm.bcast(_latest(directory) is not None if comm.rank == 0 else None, root=0))
+
+
 def _latest(directory: str) -> Optional[str]:
     try:
         with open(os.path.join(directory, "LATEST")) as f:
@@ -114,9 +138,11 @@ def _latest(directory: str) -> Optional[str]:
         return None
 
 
-def read_checkpoint(directory: str, problem, factors) -> CheckpointState:
+def read_checkpoint(directory: str, problem, factors,
+                    outputs: Sequence[ResumableOutput] = ()) -> CheckpointState:
     """Restore the latest checkpoint of ``directory`` into ``problem`` (collective): the
-    displacement, the interface's committed state and dissipation, the load factor.
+    displacement, the interface's committed state and dissipation, the load factor, and the
+    state of each of ``outputs`` (the same writers, in the same order, as when it was written).
 
     Raises:
         CheckpointError: see the module.
@@ -151,6 +177,11 @@ def read_checkpoint(directory: str, problem, factors) -> CheckpointState:
     if data["u"].shape != problem.u.x.array.shape:
         raise CheckpointError(f"rank {comm.rank}: {data['u'].shape[0]} local DOFs in the "
                               f"checkpoint, {problem.u.x.array.shape[0]} in this problem")
+    saved_outputs = data.get("outputs", [])
+    if len(saved_outputs) != len(outputs):
+        raise CheckpointError(f"the checkpoint in {directory!r} holds the state of "
+                              f"{len(saved_outputs)} output writer(s), {len(outputs)} were given: "
+                              "resume with the same outputs")
     problem.u.x.array[:] = data["u"]
     problem.u.x.scatter_forward()
     problem.set_load_factor(meta["load_factor"])
@@ -158,6 +189,8 @@ def read_checkpoint(directory: str, problem, factors) -> CheckpointState:
     if ci is not None:
         ci.history.restore(data["committed"], data["dissipated"])
         ci.revert()
+    for writer, saved in zip(outputs, saved_outputs):
+        writer.restore(saved)
     return CheckpointState(step=meta["step"], index=meta["index"], delta=meta["delta"],
                            cutbacks=meta["cutbacks"], load_factor=meta["load_factor"],
                            lam_previous=meta["lam_previous"], u_previous=data["u_previous"],

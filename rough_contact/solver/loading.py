@@ -43,7 +43,7 @@ from __future__ import annotations
 import time
 import warnings
 from dataclasses import dataclass, field
-from typing import Iterable, Iterator, Optional
+from typing import Iterable, Iterator, Optional, Sequence
 
 import numpy as np
 from mpi4py import MPI
@@ -51,7 +51,8 @@ from petsc4py import PETSc
 
 from rough_contact.fem.problem import ContactProblem
 from rough_contact.interface.contract import ConvergenceError, FrictionBoundedLaw
-from rough_contact.solver.checkpoint import CheckpointState, read_checkpoint, write_checkpoint
+from rough_contact.solver.checkpoint import (CheckpointState, ResumableOutput, read_checkpoint,
+                                             write_checkpoint)
 from rough_contact.solver.checkpoint import signature as checkpoint_signature
 from rough_contact.solver.snes import SNESSolver, SolveResult
 from rough_contact.validation import check_scalar
@@ -215,7 +216,9 @@ def load_path(problem: ContactProblem, solver: SNESSolver, factors: Iterable[flo
               verbose: bool = True, validity: str = "warn",
               predictor: str = "secant", friction_check: bool = True,
               checkpoint: Optional[str] = None,
-              resume: Optional[str] = None) -> Iterator[Increment]:
+              resume: Optional[str] = None,
+              outputs: Sequence[ResumableOutput] = (),
+              max_steps: Optional[int] = None) -> Iterator[Increment]:
     """Follow ``factors`` with Newton solves; yield after each converged, committed step.
 
     Args:
@@ -247,10 +250,19 @@ def load_path(problem: ContactProblem, solver: SNESSolver, factors: Iterable[flo
             if it is larger, raise :class:`FrictionCapacityError` instead of cutting back (the
             body slides). Turn it off for a body that other supports hold tangentially.
         checkpoint: directory receiving a checkpoint after every converged increment
-            (``rough_contact.solver.checkpoint``: atomic, two alternating slots).
+            (``rough_contact.solver.checkpoint``: atomic, two alternating slots). The
+            checkpoint of an increment is written when the caller asks for the next one (after
+            its loop body, e.g. the output of the increment; the last one when the loop ends).
         resume: directory of a checkpoint to continue from: the problem (built afresh, same
             mesh, ranks and law) gets its displacement, interface history and load factor, and
             the stepping continues where the checkpointed run stopped (same ``factors``).
+        outputs: writers (:class:`~rough_contact.solver.checkpoint.ResumableOutput`, e.g.
+            ``ResultWriter``) whose state every checkpoint saves and a resume restores, so
+            their files continue; build them with ``resume=True`` when resuming.
+        max_steps: stop after this many converged increments of this call, the last one's
+            checkpoint written (a planned stop, e.g. a batch job's time limit; continue with
+            ``resume``). A caller that leaves the loop with ``break`` instead skips the
+            checkpoint of the increment it broke at.
 
     Yields:
         :class:`Increment` per converged step.
@@ -269,11 +281,14 @@ def load_path(problem: ContactProblem, solver: SNESSolver, factors: Iterable[flo
     if validity not in VALIDITY_POLICIES:
         raise ValueError(f"validity = {validity!r} is invalid: it must be one of "
                          f"{', '.join(VALIDITY_POLICIES)}")
+    if max_steps is not None and (int(max_steps) != max_steps or max_steps < 1):
+        raise ValueError(f"max_steps = {max_steps!r} is invalid: it must be an integer >= 1")
     comm = problem.comm
     factors = list(factors)
     restored = None
+    done = 0
     if resume is not None:
-        restored = read_checkpoint(resume, problem, factors)
+        restored = read_checkpoint(resume, problem, factors, outputs)
     sig = None if checkpoint is None else checkpoint_signature(problem)
     _check_initial_guess(problem)
     interface = problem.interface
@@ -345,17 +360,22 @@ def load_path(problem: ContactProblem, solver: SNESSolver, factors: Iterable[flo
                     inc.contact_force, inc.real_area = s.contact_force, s.real_area
                     inc.dissipation = s.dissipation
                     inc.n_beyond_validity = s.n_beyond_validity
-                if checkpoint is not None:
-                    write_checkpoint(checkpoint, problem, CheckpointState(
+                if checkpoint is not None:   # written after the caller's loop body
+                    saved = CheckpointState(
                         step=step, index=i, delta=delta * max_growth if cutbacks else delta,
                         cutbacks=cutbacks, load_factor=lam, lam_previous=lam_previous,
                         u_previous=None if u_previous is None else u_previous.getArray().copy(),
-                        factors=factors), sig)
+                        factors=factors)
                 if verbose:
                     _print_increment(inc)
                 if inc.n_beyond_validity and validity != "ignore":
                     _validity_guard(inc, validity)
                 yield inc
+                if checkpoint is not None:
+                    write_checkpoint(checkpoint, problem, saved, sig, outputs)
+                done += 1
+                if max_steps is not None and done >= max_steps:
+                    return
                 t_start = time.perf_counter()
                 if cutbacks:
                     delta *= max_growth

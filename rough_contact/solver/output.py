@@ -15,6 +15,14 @@ that was written stays readable:
 * The folder holds exactly one run: earlier results make the writer refuse, or with
   ``overwrite=True`` they are removed first (``prepare_output_dir``).
 * ``history.csv``: one row per converged increment, rewritten atomically.
+* Restart (``load_path(..., checkpoint=, outputs=[writer])``): the writer's state (CSV rows,
+  load factors, the number of XDMF steps) is saved in every checkpoint
+  (:meth:`ResultWriter.checkpoint_state`); a writer built with ``resume=True`` leaves the folder
+  alone and :meth:`ResultWriter.restore` cuts every file back to the checkpointed step (steps a
+  killed run wrote after its last checkpoint are dropped from the XML index and their HDF5
+  datasets deleted), so the resumed run's increments continue the same files: one CSV, one
+  XDMF time series per file. An HDF5 file damaged by a kill in the middle of its write is
+  moved aside (``*.damaged``) and its series restarts at the resumed step, with a warning.
 """
 
 from __future__ import annotations
@@ -22,12 +30,15 @@ from __future__ import annotations
 import csv
 import io
 import os
+import warnings
+import xml.etree.ElementTree as ET
 from typing import Iterable, Optional, Sequence, Union
 
 import numpy as np
 from mpi4py import MPI
 
-__all__ = ["ResultWriter", "gather_points", "atomic_write", "atomic_write_text"]
+__all__ = ["ResultWriter", "CsvRecorder", "gather_points", "atomic_write", "atomic_write_text",
+           "truncate_time_series"]
 
 
 def atomic_write(path: str, content: Union[str, bytes, Iterable[bytes]]) -> None:
@@ -82,6 +93,62 @@ def gather_points(comm: MPI.Comm, points: np.ndarray, fields: dict, root: int = 
     return pts, out
 
 
+_XI = "http://www.w3.org/2001/XInclude"
+
+
+def truncate_time_series(path: str, n_keep: int) -> bool:
+    """Cut the DOLFINx XDMF time series ``path`` back to its first ``n_keep`` steps (serial).
+
+    Every temporal collection keeps its first ``n_keep`` grids; the HDF5 datasets of the dropped
+    grids are deleted (DOLFINx refuses to write a dataset that exists), and the XML is rewritten
+    atomically. Returns False when the files cannot be continued (missing, or an unreadable XML
+    or HDF5 file, e.g. a kill during its write): they are then moved aside as ``*.damaged`` and
+    the caller starts the series afresh.
+    """
+    import h5py
+
+    folder = os.path.dirname(path) or "."
+    h5_path = os.path.splitext(path)[0] + ".h5"
+    if not os.path.exists(path):
+        return False
+    try:
+        ET.register_namespace("xi", _XI)
+        root = ET.parse(path).getroot()
+        dropped, kept = set(), set()
+        for series in root.iter("Grid"):
+            if series.get("CollectionType") != "Temporal":
+                continue
+            for k, grid in enumerate(list(series.findall("Grid"))):
+                items = {it.text.strip() for it in grid.iter("DataItem")
+                         if it.get("Format") == "HDF"}
+                if k < n_keep:
+                    kept |= items
+                else:
+                    dropped |= items
+                    series.remove(grid)
+        with h5py.File(h5_path, "a") as h5:
+            for item in sorted(dropped - kept):
+                name, _, dataset = item.partition(":")
+                if os.path.join(folder, name) == h5_path and dataset in h5:
+                    del h5[dataset]
+            for item in kept:                     # every kept step must be readable
+                name, _, dataset = item.partition(":")
+                if os.path.join(folder, name) == h5_path:
+                    h5[dataset].shape             # noqa: B018 -- raises if missing/damaged
+    except (ET.ParseError, OSError, KeyError) as exc:
+        for f in (path, h5_path):
+            if os.path.exists(f):
+                os.replace(f, f + ".damaged")
+        warnings.warn(f"{path} could not be continued ({type(exc).__name__}: {exc}); moved "
+                      "aside as *.damaged, the time series restarts at the resumed step",
+                      RuntimeWarning, stacklevel=2)
+        return False
+    text = ET.tostring(root, encoding="unicode")
+    atomic_write_text(path, '<?xml version="1.0"?>\n<!DOCTYPE Xdmf SYSTEM "Xdmf.dtd" []>\n'
+                      + text + "\n")
+    return True
+
+
 _CSV_COLUMNS = [
     ("step", "step"), ("load_factor", "load_factor"), ("target", "target"),
     ("newton_its", "iterations"), ("residual_N", "residual"), ("n_points", "n_points"),
@@ -114,21 +181,29 @@ class ResultWriter:
 
     def __init__(self, outdir: str, comm: MPI.Comm, u=None, interface=None, *,
                  points: bool = True, extra_columns: tuple = (), overwrite: bool = False,
-                 extra_patterns: Sequence[str] = ()):
+                 extra_patterns: Sequence[str] = (), resume: bool = False):
         from rough_contact.fem.interface_output import InterfaceWriter, prepare_output_dir
 
         self.outdir = os.fspath(outdir)
         self.comm = comm
-        self.removed = prepare_output_dir(self.outdir, comm, overwrite=overwrite,
-                                          extra_patterns=extra_patterns)
+        if resume:       # the files belong to the run being resumed: restore() trims them
+            self.removed = []
+            if comm.rank == 0:
+                os.makedirs(self.outdir, exist_ok=True)
+            comm.Barrier()
+        else:
+            self.removed = prepare_output_dir(self.outdir, comm, overwrite=overwrite,
+                                              extra_patterns=extra_patterns)
         self.u = u
         self.interface_writer = (None if interface is None
-                                 else InterfaceWriter(self.outdir, interface, points=points))
+                                 else InterfaceWriter(self.outdir, interface, points=points,
+                                                      resume=resume))
         self.extra_columns = tuple(extra_columns)
         self.rows: list = []
         self.load_factors: list = []
         self._u_out = None
         self._xdmf_started = False
+        self._xdmf_steps = 0
         if u is not None:
             from dolfinx import fem
 
@@ -155,6 +230,33 @@ class ResultWriter:
                 xdmf.write_mesh(self.u.function_space.mesh)
             xdmf.write_function(self._u_out, t)
         self._xdmf_started = True
+        self._xdmf_steps += 1
+
+    # ------------------------------------------------------------------ restart
+    def checkpoint_state(self) -> dict:
+        """What :meth:`restore` needs to continue these files (this rank's, picklable)."""
+        return dict(rows=list(self.rows), load_factors=list(self.load_factors),
+                    xdmf_steps=self._xdmf_steps,
+                    interface=None if self.interface_writer is None
+                    else self.interface_writer.checkpoint_state())
+
+    def restore(self, state: dict) -> None:
+        """Continue from :meth:`checkpoint_state` (collective): cut the CSV, the displacement
+        series and the interface files back to the checkpointed step."""
+        from rough_contact.fem.interface_output import _collective
+
+        self.rows = list(state["rows"])
+        self.load_factors = list(state["load_factors"])
+        if self.comm.rank == 0 and self.rows:
+            self._flush_csv()
+        if self.u is not None:
+            n = int(state["xdmf_steps"])
+            ok = _collective(self.comm, lambda: truncate_time_series(self.u_path, n)) if n else \
+                False
+            self._xdmf_started = ok
+            self._xdmf_steps = n if ok else 0
+        if self.interface_writer is not None:
+            self.interface_writer.restore(state["interface"])
 
     # ------------------------------------------------------------------ CSV
     def _write_csv(self, inc, extra: Optional[dict]) -> None:
@@ -165,6 +267,9 @@ class ResultWriter:
         row += list(np.asarray(inc.contact_force, dtype=float).reshape(3))
         row += [(extra or {}).get(k, "") for k in self.extra_columns]
         self.rows.append(row)
+        self._flush_csv()
+
+    def _flush_csv(self) -> None:
         header = [c for c, _ in _CSV_COLUMNS] + ["applied_fx_N", "applied_fy_N", "applied_fz_N",
                                                  "contact_fx_N", "contact_fy_N", "contact_fz_N"]
         header += list(self.extra_columns)
@@ -189,3 +294,51 @@ class ResultWriter:
         if self.interface_writer is not None:
             self.interface_writer.write(inc.load_factor, t)
         self._write_csv(inc, extra)
+
+
+class CsvRecorder:
+    """Rows of named values, one per increment, kept on every rank and written by rank 0 to
+    ``path`` (rewritten atomically per row; ``None``: memory only). Resumable: pass it in
+    ``load_path(..., outputs=[recorder])`` and a resumed run continues its rows and file.
+
+    Args:
+        path: CSV file, or None.
+        columns: column names.
+        comm: communicator.
+    """
+
+    def __init__(self, path: Optional[str], columns: Sequence[str], comm: MPI.Comm):
+        self.path = None if path is None else os.fspath(path)
+        self.columns = tuple(columns)
+        self.comm = comm
+        self.rows: list = []
+
+    def add(self, row: Sequence[float]) -> None:
+        """Append one row (the same on every rank) and rewrite the file."""
+        if len(row) != len(self.columns):
+            raise ValueError(f"a row of {len(row)} values for {len(self.columns)} columns "
+                             f"({', '.join(self.columns)})")
+        self.rows.append(tuple(float(v) for v in row))
+        self._flush()
+
+    def _flush(self) -> None:
+        if self.path is None or self.comm.rank != 0:
+            return
+        os.makedirs(os.path.dirname(self.path) or ".", exist_ok=True)
+        text = io.StringIO(newline="")
+        w = csv.writer(text)
+        w.writerow(self.columns)
+        w.writerows([[f"{v:.12g}" for v in r] for r in self.rows])
+        atomic_write(self.path, text.getvalue())
+
+    def array(self) -> np.ndarray:
+        """(n_rows, n_columns) values."""
+        return np.array(self.rows, dtype=float).reshape(-1, len(self.columns))
+
+    def checkpoint_state(self) -> list:
+        return list(self.rows)
+
+    def restore(self, state: list) -> None:
+        self.rows = list(state)
+        self._flush()
+

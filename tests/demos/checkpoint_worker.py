@@ -1,7 +1,9 @@
 """Worker for tests/demos/test_multiprocess.py (run under mpirun): the checkpoint test's
 preload + cyclic rough-law program, uninterrupted ("full"), writing checkpoints ("checkpointed",
 printing each converged step and this rank's PID), or resumed from a directory ("resume").
-Writes the final figures as JSON (rank 0). Usage: checkpoint_worker.py MODE DIR OUT.json"""
+Every mode writes its results (ResultWriter) into OUT.json's name without the suffix + "_out";
+"checkpointed" and "resume" share DIR + "_out". Writes the final figures as JSON (rank 0).
+Usage: checkpoint_worker.py MODE DIR OUT.json"""
 
 import json
 import os
@@ -15,6 +17,7 @@ sys.path.insert(0, str(Path(__file__).parents[1] / "fem"))
 import test_checkpoint  # noqa: E402  (the checkpoint test's model, with a longer program)
 
 from rough_contact.solver.loading import load_path  # noqa: E402
+from rough_contact.solver.output import ResultWriter  # noqa: E402
 from rough_contact.solver.program import preload_then_cyclic  # noqa: E402
 
 PROGRAM = test_checkpoint.PROGRAM = preload_then_cyclic(preload_steps=2, cycles=2,
@@ -33,8 +36,13 @@ def main(mode, directory, out):
     pids = comm.gather(os.getpid(), root=0)
     if mode == "checkpointed" and comm.rank == 0:
         print("PIDS " + " ".join(str(p) for p in pids), flush=True)
+    outdir = str(directory) + "_out" if mode != "full" else os.path.splitext(out)[0] + "_out"
+    writer = ResultWriter(outdir, comm, u=problem.u, interface=problem.interface,
+                          resume=mode == "resume")
     last = first = None
-    for inc in load_path(problem, solver, PROGRAM.times, verbose=False, **kwargs):
+    for inc in load_path(problem, solver, PROGRAM.times, verbose=False, outputs=[writer],
+                         **kwargs):
+        writer.write(inc)
         last = inc
         first = inc.step if first is None else first
         if mode == "checkpointed" and comm.rank == 0:

@@ -172,31 +172,35 @@ def test_demo_bolt_head(tmp_path):
 
 
 def test_demo_flat_punch_restart(tmp_path):
-    """A run stopped after its first increment (checkpoint written by the library, as a killed
-    demo leaves it) and continued with ``--restart`` ends with the dissipation of the
-    uninterrupted run; the restarted output holds the remaining increments only; restarting
-    from the checkpoint of a finished run has nothing left to do."""
+    """A run stopped after its first increment (``--stop-after 1``, its checkpoint written) and
+    continued with ``--restart`` into the same folder ends with the dissipation of the
+    uninterrupted run, and its history.csv and displacement.xdmf hold every increment once with
+    the uninterrupted run's values; restarting from the checkpoint of a finished run has nothing
+    left to do."""
     import re
+
+    sys.path.insert(0, str(Path(__file__).parents[1] / "fem"))
+    from test_checkpoint import _csv, _xdmf_steps
 
     full = run([DEMOS / "demo_flat_punch.py", *PUNCH_SMALL, "--outdir", tmp_path / "full"],
                tmp_path)
-    script = tmp_path / "partial.py"
-    script.write_text(
-        "from mpi4py import MPI\n"
-        "from rough_contact.scenes import flat_punch\n"
-        "from rough_contact.solver.loading import load_path, load_unload_factors\n"
-        "m = flat_punch.build(MPI.COMM_WORLD, 20.0, 5.0, 1, 2.5, 'rough', 'b', 'elastic', 2,\n"
-        "                     'rc_', None)\n"
-        "for inc in load_path(m.problem, m.solver, load_unload_factors(2, 1),\n"
-        f"                     checkpoint={str(tmp_path / 'ckpt')!r}):\n"
-        "    break                                   # stopped after the first increment\n")
-    run([script], tmp_path)
+    stopped = run([DEMOS / "demo_flat_punch.py", *PUNCH_SMALL, "--outdir", tmp_path / "rest",
+                   "--checkpoint", tmp_path / "ckpt", "--stop-after", "1"], tmp_path)
+    assert "Stopped after 1 increments" in stopped
     resumed = run([DEMOS / "demo_flat_punch.py", *PUNCH_SMALL, "--outdir", tmp_path / "rest",
                    "--restart", tmp_path / "ckpt", "--checkpoint", tmp_path / "ckpt"], tmp_path)
     pattern = r"Total frictional dissipation D .*?: ([0-9.eE+-]+) N mm"
     assert re.search(pattern, resumed).group(1) == re.search(pattern, full).group(1)
-    with open(tmp_path / "rest" / "history.csv") as f:
-        assert len(f.read().strip().splitlines()) == 1 + 2       # header + increments 2 and 3
+    got, want = _csv(tmp_path / "rest" / "history.csv"), _csv(tmp_path / "full" / "history.csv")
+    assert [r["step"] for r in got] == [r["step"] for r in want] == [1, 2, 3]
+    for g, w in zip(got, want):
+        assert g["dissipation_Nmm"] == pytest.approx(w["dissipation_Nmm"], rel=1e-9, abs=1e-12)
+    t_got, u_got = _xdmf_steps(tmp_path / "rest" / "displacement.xdmf")
+    t_want, u_want = _xdmf_steps(tmp_path / "full" / "displacement.xdmf")
+    assert t_got == t_want
+    for t in t_want:
+        np.testing.assert_allclose(u_got[t], u_want[t], rtol=0,
+                                   atol=1e-10 * np.abs(u_want[t_want[1]]).max())
     again = run([DEMOS / "demo_flat_punch.py", *PUNCH_SMALL, "--outdir", tmp_path / "again",
                  "--restart", tmp_path / "ckpt"], tmp_path)   # the checkpoint is now the end
     assert "Nothing left to do" in again

@@ -9,7 +9,9 @@ slip hardening) writing a checkpoint at every converged increment; once a given 
 reported, rank 1 is killed with SIGKILL (so the kill lands wherever that rank is: solving the
 next increment or writing its checkpoint; the test is repeated at three steps). A fresh 2-rank run
 resumes from the directory; its final dissipation, contact force and displacement norm equal the
-uninterrupted run's to 1e-12 relative.
+uninterrupted run's to 1e-12 relative, and its output files (history.csv, displacement.xdmf,
+interface.xdmf, written by the killed run and continued by the resumed one) hold every increment
+once with the uninterrupted run's values.
 
 (2) The non-matching pairings' rank-independence test on 3 ranks (issue 9: 1 = 2 = 3 ranks).
 
@@ -43,6 +45,31 @@ def _run(mode, directory, out, timeout=600):
     return json.loads(Path(out).read_text())
 
 
+def _same_output(run, ref, n_steps):
+    """The killed-and-resumed run's files hold each increment once, as the reference's do."""
+    sys.path.insert(0, str(Path(__file__).parents[1] / "fem"))
+    from test_checkpoint import _csv, _xdmf_steps
+
+    from rough_contact.fem.interface_output import read_interface_results
+
+    got, want = _csv(run / "history.csv"), _csv(ref / "history.csv")
+    assert [r["step"] for r in got] == list(range(1, n_steps + 1))
+    for g, w in zip(got, want):
+        for key in ("load_factor", "dissipation_Nmm", "contact_fz_N", "contact_fx_N"):
+            assert g[key] == pytest.approx(w[key], rel=1e-9, abs=1e-12), key
+    t_run, u_run = _xdmf_steps(run / "displacement.xdmf")
+    t_ref, u_ref = _xdmf_steps(ref / "displacement.xdmf")
+    assert t_run == t_ref and len(t_ref) == n_steps
+    scale = max(np.abs(u).max() for u in u_ref.values())
+    for t in t_ref:
+        np.testing.assert_allclose(u_run[t], u_ref[t], rtol=0, atol=1e-12 * scale)
+    a, b = read_interface_results(str(run / "interface.xdmf")), \
+        read_interface_results(str(ref / "interface.xdmf"))
+    np.testing.assert_array_equal(a.times, b.times)
+    np.testing.assert_allclose(a.field("dissipation_N_per_mm"), b.field("dissipation_N_per_mm"),
+                               rtol=1e-9, atol=1e-12 * np.abs(b.field("dissipation_N_per_mm")).max())
+
+
 @pytest.mark.skipif(MPIRUN is None, reason="needs mpirun")
 def test_sigkill_then_resume(tmp_path):
     reference = _run("full", tmp_path / "unused", tmp_path / "full.json")
@@ -67,8 +94,10 @@ def test_sigkill_then_resume(tmp_path):
         assert killed and proc.returncode != 0           # the run did die
         resumed = _run("resume", directory, tmp_path / f"resumed_{kill_after}.json")
         assert resumed["step"] == reference["step"]
-        # it did resume: from the last complete checkpoint, at or after the reported step
-        assert kill_after + 1 <= resumed["first"] <= reference["step"]
+        # it did resume from the last complete checkpoint: the checkpoint of step k is written
+        # after the loop body of step k (its output), so at or after the reported step
+        assert kill_after <= resumed["first"] <= reference["step"]
+        _same_output(Path(f"{directory}_out"), tmp_path / "full_out", reference["step"])
         for key in ("D", "unorm", "umax"):
             assert resumed[key] == pytest.approx(reference[key], rel=1e-12), key
         np.testing.assert_allclose(resumed["F"], reference["F"], rtol=1e-12,

@@ -2,10 +2,12 @@
 
 Reference: the same program run without interruption. Two blocks with the paper's rough law
 (slip-hardening friction, case b), a preload and one tangential cycle of +-2 um (slip, hardening:
-history matters). A run that writes checkpoints is stopped after 6 increments; a freshly built
-problem resumes from the directory: its increments must equal the uninterrupted run's
-(displacement to 1e-12 of its maximum, dissipation and contact forces to 1e-12 relative), and the
-step numbers continue. A checkpoint of another problem, other load factors, or an empty
+history matters). A run that writes checkpoints and results is stopped after writing the output
+of increment 7 but before its checkpoint (the window a kill can hit); a freshly built problem
+resumes from the directory: its increments must equal the uninterrupted run's (displacement to
+1e-12 of its maximum, dissipation and contact forces to 1e-12 relative), the step numbers
+continue, and the output files continue: history.csv, displacement.xdmf and interface.xdmf hold
+each increment once and equal the uninterrupted run's files. A checkpoint of another problem, other load factors, or an empty
 directory are refused with a clear error. Units: mm, N, MPa.
 """
 
@@ -18,12 +20,14 @@ from petsc4py import PETSc
 
 from dolfinx import fem
 from rough_contact.fem.contact import ContactInterface
+from rough_contact.fem.interface_output import read_interface_results
 from rough_contact.fem.problem import (ContactProblem, Material, PrescribedDisplacement,
                                        SurfaceLoad)
 from rough_contact.scenes import flat_punch
 from rough_contact.scenes.meshes.blocks import two_blocks
 from rough_contact.solver.checkpoint import CheckpointError
 from rough_contact.solver.loading import load_path
+from rough_contact.solver.output import ResultWriter
 from rough_contact.solver.program import preload_then_cyclic
 from rough_contact.solver.snes import SNESSolver
 
@@ -57,25 +61,64 @@ def _record(problem, inc):
                 D=inc.dissipation, F=inc.contact_force.copy())
 
 
+def _csv(path):
+    import csv
+
+    with open(path) as f:
+        rows = list(csv.DictReader(f))
+    skip = {"wall_time_s"}
+    return [{k: float(v) for k, v in r.items() if k not in skip and v != ""} for r in rows]
+
+
+def _xdmf_steps(path):
+    """(time values, {time: displacement array}) of a DOLFINx XDMF time series."""
+    import os
+    import xml.etree.ElementTree as ET
+
+    import h5py
+
+    root = ET.parse(path).getroot()
+    times, data = [], {}
+    h5 = os.path.splitext(path)[0] + ".h5"
+    with h5py.File(h5, "r") as f:
+        for grid in root.iter("Grid"):
+            if grid.get("GridType") == "Uniform" and grid.find("Time") is not None:
+                t = float(grid.find("Time").get("Value"))
+                item = grid.find("Attribute/DataItem").text.strip().partition(":")[2]
+                times.append(t)
+                data[t] = f[item][...]
+    return times, data
+
+
 def test_resume_reproduces_the_uninterrupted_run(tmp_path):
-    directory = MPI.COMM_WORLD.bcast(str(tmp_path / "ckpt"), root=0)
+    comm = MPI.COMM_WORLD
+    directory = comm.bcast(str(tmp_path / "ckpt"), root=0)
+    out_ref, out_run = comm.bcast((str(tmp_path / "ref"), str(tmp_path / "run")), root=0)
     problem, solver = _model()
-    reference = [_record(problem, i) for i in load_path(problem, solver, PROGRAM.times,
-                                                        verbose=False)]
+    writer = ResultWriter(out_ref, comm, u=problem.u, interface=problem.interface)
+    reference = []
+    for inc in load_path(problem, solver, PROGRAM.times, verbose=False):
+        writer.write(inc)
+        reference.append(_record(problem, inc))
     solver.destroy()
     assert reference[-1]["D"] > 0.0                      # the cycle slipped: history matters
 
     problem, solver = _model()
-    first = []
-    for inc in load_path(problem, solver, PROGRAM.times, verbose=False, checkpoint=directory):
-        first.append(_record(problem, inc))
-        if len(first) == 6:
-            break                                        # the run stops here
+    writer = ResultWriter(out_run, comm, u=problem.u, interface=problem.interface)
+    for inc in load_path(problem, solver, PROGRAM.times, verbose=False, checkpoint=directory,
+                         outputs=[writer]):
+        writer.write(inc)
+        if inc.step == 7:
+            break        # the run stops after writing step 7, before its checkpoint
     solver.destroy()
 
     problem, solver = _model()
-    resumed = [_record(problem, i) for i in load_path(problem, solver, PROGRAM.times,
-                                                      verbose=False, resume=directory)]
+    writer = ResultWriter(out_run, comm, u=problem.u, interface=problem.interface, resume=True)
+    resumed = []
+    for inc in load_path(problem, solver, PROGRAM.times, verbose=False, resume=directory,
+                         outputs=[writer]):
+        writer.write(inc)
+        resumed.append(_record(problem, inc))
     solver.destroy()
     assert [r["step"] for r in resumed] == list(range(7, len(reference) + 1))
     assert [r["lam"] for r in resumed] == [r["lam"] for r in reference[6:]]
@@ -84,6 +127,29 @@ def test_resume_reproduces_the_uninterrupted_run(tmp_path):
         np.testing.assert_allclose(got["u"], ref["u"], rtol=0, atol=1e-12 * scale)
         assert got["D"] == pytest.approx(ref["D"], rel=1e-12, abs=1e-15)
         np.testing.assert_allclose(got["F"], ref["F"], rtol=1e-12, atol=1e-12 * abs(ref["F"][2]))
+
+    # the output continues: every increment once, equal to the uninterrupted run's files
+    if comm.rank == 0:
+        import os
+
+        run_rows, ref_rows = _csv(f"{out_run}/history.csv"), _csv(f"{out_ref}/history.csv")
+        assert [r["step"] for r in run_rows] == list(range(1, len(reference) + 1))
+        for got, ref in zip(run_rows, ref_rows):
+            for key in ("load_factor", "dissipation_Nmm", "contact_fz_N", "contact_fx_N"):
+                assert got[key] == pytest.approx(ref[key], rel=1e-9, abs=1e-12), key
+        t_run, u_run = _xdmf_steps(f"{out_run}/displacement.xdmf")
+        t_ref, u_ref = _xdmf_steps(f"{out_ref}/displacement.xdmf")
+        assert t_run == t_ref and len(t_ref) == len(reference)
+        for t in t_ref:
+            np.testing.assert_allclose(u_run[t], u_ref[t], rtol=0, atol=1e-12 * scale)
+        got, ref = (read_interface_results(f"{d}/interface.xdmf") for d in (out_run, out_ref))
+        np.testing.assert_array_equal(got.times, ref.times)
+        for name in ("pressure_MPa", "dissipation_N_per_mm"):
+            for k in (6, -1):
+                np.testing.assert_allclose(got.field(name, k), ref.field(name, k),
+                                           rtol=1e-9, atol=1e-12 * np.abs(ref.field(name)).max())
+        assert not [f for f in os.listdir(out_run) if f.endswith(".damaged")]
+    comm.Barrier()
 
 
 def test_resume_refuses_another_problem(tmp_path):

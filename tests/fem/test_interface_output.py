@@ -489,3 +489,70 @@ def test_paraview_reads_surface(punch):
     arrays = dict(ast.literal_eval(arrays))
     assert set(arrays) == set(FACET_FIELD_NAMES)
     assert all(arrays[n] == 3 for n in VECTORS)
+
+
+def _series(comm, path, times):
+    from dolfinx.io import XDMFFile
+
+    msh = dolfinx.mesh.create_unit_cube(comm, 2, 2, 2)
+    u = fem.Function(fem.VectorFunctionSpace(msh, ("Lagrange", 1)), name="u")
+    for k, t in enumerate(times):
+        u.x.array[:] = t
+        with XDMFFile(comm, path, "w" if k == 0 else "a") as f:
+            if k == 0:
+                f.write_mesh(msh)
+            f.write_function(u, t)
+    return u
+
+
+def test_time_series_cut_back_and_continued():
+    """A restart's trimming (output.truncate_time_series): a DOLFINx XDMF series of 4 steps cut
+    back to 2 keeps those 2 (XML and data), drops the others' datasets, and DOLFINx can then
+    append the same time values again (it refuses a dataset that exists)."""
+    from dolfinx.io import XDMFFile
+
+    from rough_contact.solver.output import truncate_time_series
+
+    comm = MPI.COMM_WORLD
+    folder = comm.bcast(tempfile.mkdtemp() if comm.rank == 0 else None, root=0)
+    path = os.path.join(folder, "displacement.xdmf")
+    u = _series(comm, path, [0.25, 0.5, 0.75, 1.0])
+    if comm.rank == 0:
+        assert truncate_time_series(path, 2)
+        root = ET.parse(path).getroot()
+        times = [float(t.get("Value")) for t in root.iter("Time")]
+        assert times == [0.25, 0.5]
+        with h5py.File(os.path.join(folder, "displacement.h5"), "r") as h5:
+            assert sorted(h5["Function/u"]) == ["0_25", "0_5"]
+            np.testing.assert_allclose(h5["Function/u/0_5"][...], 0.5, rtol=1e-14)
+    comm.Barrier()
+    for t in (0.75, 1.0):                               # the resumed run writes them again
+        u.x.array[:] = 10 * t
+        with XDMFFile(comm, path, "a") as f:
+            f.write_function(u, t)
+    if comm.rank == 0:
+        root = ET.parse(path).getroot()
+        assert [float(t.get("Value")) for t in root.iter("Time")] == [0.25, 0.5, 0.75, 1.0]
+        with h5py.File(os.path.join(folder, "displacement.h5"), "r") as h5:
+            np.testing.assert_allclose(h5["Function/u/1"][...], 10.0, rtol=1e-14)
+        shutil.rmtree(folder)
+
+
+def test_damaged_time_series_moved_aside():
+    """An HDF5 file a kill damaged in the middle of its write cannot be continued: it is moved
+    aside with a warning and the caller is told to start the series afresh."""
+    from rough_contact.solver.output import truncate_time_series
+
+    if MPI.COMM_WORLD.rank != 0:
+        return
+    folder = tempfile.mkdtemp()
+    path = os.path.join(folder, "displacement.xdmf")
+    _series(MPI.COMM_SELF, path, [0.5, 1.0])
+    h5 = os.path.join(folder, "displacement.h5")
+    with open(h5, "r+b") as f:                          # a torn write: the superblock is gone
+        f.write(b"\0" * 64)
+    with pytest.warns(RuntimeWarning, match="could not be continued .* moved aside"):
+        assert not truncate_time_series(path, 1)
+    assert sorted(os.listdir(folder)) == ["displacement.h5.damaged", "displacement.xdmf.damaged"]
+    assert not truncate_time_series(path, 1)            # nothing left: start afresh
+    shutil.rmtree(folder)
