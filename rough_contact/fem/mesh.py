@@ -549,6 +549,119 @@ def scene_from_msh_files(paths: typing.Sequence, comm: MPI.Comm, *, contact_pair
                             rank=rank, dimensions=dimensions)
 
 
+_DOLFINX_TO_GMSH = {("tetrahedron", 1): 4, ("tetrahedron", 2): 11, ("hexahedron", 1): 5,
+                    ("hexahedron", 2): 12}
+
+
+def _read_xdmf_part(path: str, labels: dict, mesh_name: str, cell_tags: str,
+                    facet_tags: str) -> dict:
+    """The arrays of one XDMF mesh file (serial, on the reading rank), in gmsh node order."""
+    from dolfinx.io import XDMFFile
+
+    with XDMFFile(MPI.COMM_SELF, path, "r") as xdmf:
+        msh = xdmf.read_mesh(name=mesh_name)
+        tdim = msh.topology.dim
+        msh.topology.create_connectivity(tdim - 1, tdim)
+        try:
+            ct = xdmf.read_meshtags(msh, name=cell_tags)
+            ft = xdmf.read_meshtags(msh, name=facet_tags)
+        except RuntimeError as exc:
+            raise ValueError(f"{path!r} must hold mesh tags named {cell_tags!r} and "
+                             f"{facet_tags!r} (as rough_contact.fem.mesh.write_xdmf writes "
+                             f"them): {exc}") from None
+    name = msh.topology.cell_type.name
+    degree = msh.geometry.cmap.degree
+    key = (name, degree)
+    if key not in _DOLFINX_TO_GMSH:
+        raise ValueError(f"{path!r}: {name} cells of degree {degree} are not supported; "
+                         f"supported: {sorted(_DOLFINX_TO_GMSH)}")
+    gmsh_cell = _DOLFINX_TO_GMSH[key]
+    n_nodes = {4: 4, 11: 10, 5: 8, 12: 27}[gmsh_cell]
+    dolfinx_cell = dolfinx.cpp.mesh.to_type(name)
+    x = np.array(msh.geometry.x, dtype=np.float64)
+    dofmap = np.asarray(msh.geometry.dofmap.array, dtype=np.int64).reshape(-1, n_nodes)
+    cells = np.empty_like(dofmap)
+    cells[:, dolfinx.cpp.io.perm_gmsh(dolfinx_cell, n_nodes)] = dofmap   # back to gmsh order
+    n_cells = len(cells)
+    cell_values = np.full(n_cells, -1, dtype=np.int32)
+    cell_values[ct.indices] = ct.values
+    if (cell_values < 0).any():
+        raise ValueError(f"{path!r}: {int((cell_values < 0).sum())} of {n_cells} cells carry no "
+                         f"cell tag: every cell must belong to a body")
+    facet_cell = dolfinx.cpp.mesh.cell_entity_type(dolfinx_cell, tdim - 1, 0)
+    # geometry nodes of each tagged facet (all of them for P2: DOLFINx 0.5's
+    # entities_to_geometry gives the vertices only), through a cell holding it
+    msh.topology.create_connectivity(tdim, tdim - 1)
+    f2c, c2f = (msh.topology.connectivity(tdim - 1, tdim), msh.topology.connectivity(tdim, tdim - 1))
+    f = np.asarray(ft.indices, dtype=np.int64)
+    cell = f2c.array[f2c.offsets[f]]
+    local = np.argmax(c2f.array.reshape(n_cells, -1)[cell] == f[:, None], axis=1)
+    layout = msh.geometry.cmap.create_dof_layout()
+    closure = np.array([layout.entity_closure_dofs(tdim - 1, j)
+                        for j in range(c2f.array.size // n_cells)], dtype=np.int64)
+    facet_nodes = dofmap[cell[:, None], closure[local]]
+    facets = np.empty_like(facet_nodes)
+    facets[:, dolfinx.cpp.io.perm_gmsh(facet_cell, facet_nodes.shape[1])] = facet_nodes
+    found = set(np.unique(cell_values).tolist()) | set(np.unique(ft.values).tolist())
+    named = {int(v) for v in labels.values()}
+    if found - named:
+        raise ValueError(f"{path!r}: tags {sorted(found - named)} have no name in its labels "
+                         f"{labels}")
+    bodies = tuple(n for n, t in labels.items() if t in set(np.unique(cell_values).tolist()))
+    return dict(x=x, cells=cells, cell_values=cell_values, facets=facets,
+                facet_values=np.asarray(ft.values, dtype=np.int32), cell_type=gmsh_cell,
+                labels={n: int(t) for n, t in labels.items()}, bodies=bodies, n_shared=0,
+                n_facet_nodes=int(facets.shape[1]))
+
+
+def scene_from_xdmf_files(parts: typing.Sequence, comm: MPI.Comm, *, contact_pair: tuple,
+                          rigid_plane: typing.Optional[tuple] = None, rank: int = 0,
+                          dimensions: typing.Optional[dict] = None, mesh_name: str = "mesh",
+                          cell_tags: str = "cell_tags",
+                          facet_tags: str = "facet_tags") -> Scene:
+    """One scene from several XDMF mesh files written by DOLFINx (e.g. two parts a user meshed
+    and saved separately), for a non-matching interface. Collective.
+
+    Each file holds one mesh with its cell tags (one value per body) and facet tags (the named
+    surfaces), as :func:`write_xdmf` writes them (``XDMFFile.write_mesh`` + ``write_meshtags``).
+    XDMF stores no names, so every file comes with its labels. The files are read on ``rank``
+    (serially), their arrays concatenated (bodies of different files share no node) and
+    distributed as for :func:`scene_from_gmsh`; tags keep their values.
+
+    Args:
+        parts: ``(path, labels)`` per file, labels = {name: tag} of its bodies and surfaces
+            (e.g. ``scene.labels`` of the scene that wrote it).
+        contact_pair: (first contact surface name, second name).
+        mesh_name, cell_tags, facet_tags: the names of the mesh and tag grids in the files.
+
+    Raises:
+        ValueError: a missing file, missing tags, tags without a name, clashing names or tags
+            between files, different cell types or degrees.
+    """
+    import os
+
+    parts = [(os.fspath(path), dict(labels)) for path, labels in parts]
+
+    def read():
+        arrays = []
+        for path, labels in parts:
+            if not os.path.isfile(path):
+                raise ValueError(f"mesh file {path!r} does not exist")
+            arrays.append(_read_xdmf_part(path, labels, mesh_name, cell_tags, facet_tags))
+        degrees = {a["cell_type"] for a in arrays}
+        if len(degrees) != 1:
+            raise ValueError(f"the XDMF files hold different cell types or degrees (gmsh types "
+                             f"{sorted(degrees)}): all bodies must use the same element")
+        data = _merge_models(arrays)
+        data["x"], data["cells"], data["facets"] = _drop_unused_nodes(
+            data["x"], data["cells"], data["facets"], data["facet_values"], {})
+        return data
+
+    data = _on_rank(comm, rank, read)
+    return _scene_from_data(data, comm, contact_pair=contact_pair, rigid_plane=rigid_plane,
+                            rank=rank, dimensions=dimensions)
+
+
 def _scene_from_data(data, comm, *, contact_pair, rigid_plane, rank, dimensions) -> Scene:
     """Distribute the arrays read by :func:`_read_model` (on ``rank``; None elsewhere)."""
     meta = comm.bcast(None if data is None else

@@ -222,7 +222,7 @@ def test_errors():
     assert ci.pairing_used == "projection"
 
 
-def _write_block_msh(path, z0, height, size, prefix, body_tag, tag0):
+def _write_block_msh(path, z0, height, size, prefix, body_tag, tag0, order=1):
     """A block [0, 1]^2 x [z0, z0 + height] as its own .msh file (gmsh, rank 0 only)."""
     import gmsh
 
@@ -244,6 +244,7 @@ def _write_block_msh(path, z0, height, size, prefix, body_tag, tag0):
             gmsh.model.setPhysicalName(2, tag0 + k, f"{prefix}_{name}")
         gmsh.option.setNumber("Mesh.MeshSizeMax", size)
         gmsh.model.mesh.generate(3)
+        gmsh.model.mesh.setOrder(order)
         gmsh.write(str(path))
     finally:
         gmsh.finalize()
@@ -287,3 +288,56 @@ def test_two_msh_files_make_one_scene(tmp_path):
     with pytest.raises(ValueError, match="does not exist"):
         scene_from_msh_files([lower, f"{folder}/nothing.msh"], comm,
                              contact_pair=("lower_top", "x"))
+
+
+@pytest.mark.parametrize("order", [1, 2])
+def test_two_xdmf_files_make_one_scene(tmp_path, order):
+    """Two parts meshed and saved separately as DOLFINx XDMF files (mesh, cell tags, facet
+    tags; sizes 0.2 and 0.28, P1 and P2) make one scene with their tags; the mortar pairing
+    between them transmits a uniform pressure exactly (patch test)."""
+    from rough_contact.fem.mesh import measure_of, scene_from_msh_files, scene_from_xdmf_files
+    from rough_contact.fem.mesh import write_xdmf
+
+    comm = MPI.COMM_WORLD
+    folder = comm.bcast(str(tmp_path), root=0)
+    labels = {}
+    for name, z0, h, size, body, tag0 in (("lower", -1.0, 1.0, 0.2, 2, 20),
+                                          ("upper", 0.0, 0.5, 0.28, 1, 10)):
+        if comm.rank == 0:
+            _write_block_msh(f"{folder}/{name}.msh", z0, h, size, name, body, tag0, order)
+        comm.Barrier()
+        part = scene_from_msh_files([f"{folder}/{name}.msh"], comm,
+                                    contact_pair=(f"{name}_top", f"{name}_bottom"))
+        write_xdmf(part, f"{folder}/{name}.xdmf")      # what a user's own script would write
+        labels[name] = part.labels
+    scene = scene_from_xdmf_files([(f"{folder}/lower.xdmf", labels["lower"]),
+                                   (f"{folder}/upper.xdmf", labels["upper"])], comm,
+                                  contact_pair=("upper_bottom", "lower_top"))
+    assert scene.order == order and set(scene.bodies) == {"lower", "upper"}
+    for name, value in (("lower", 1.0), ("upper", 0.5), ("upper_bottom", 1.0), ("lower_x0", 1.0)):
+        assert measure_of(scene, name) == pytest.approx(value, rel=1e-10), name
+    V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", order))
+    bcs = [roller(V, scene, f"{b}_{s}", c) for b in ("lower", "upper")
+           for s, c in (("x0", 0), ("y0", 1))] + [roller(V, scene, "lower_bottom", 2)]
+    ci = ContactInterface(V, scene.facet_tags, *scene.contact_pair, law=LinearPenalty(1e6),
+                          bcs=bcs, pairing="mortar", quadrature_degree=2 * order)
+    mats = {scene.tag("upper"): Material(E, NU), scene.tag("lower"): Material(0.5 * E, NU)}
+    problem = ContactProblem(V, mats, bcs, [SurfaceLoad(scene.tag("upper_top"),
+                                                        traction=[0, 0, -80.0])],
+                             cell_tags=scene.cell_tags, facet_tags=scene.facet_tags,
+                             interface=ci)
+    solver = SNESSolver(problem, prefix="test_xdmf_files_")
+    problem.set_load_factor(1.0)
+    assert solver.solve().converged
+    ci.evaluate(problem.u)
+    pf = ci.point_fields()
+    real = pf.weight > 0
+    err = comm.allreduce(float(np.abs(pf.pressure[real] - 80.0).max(initial=0.0)), op=MPI.MAX)
+    assert err <= 1e-8 * 80.0
+    solver.destroy()
+    with pytest.raises(ValueError, match=r"tags \[1\d\] have no name|tags \[.*\] have no name"):
+        scene_from_xdmf_files([(f"{folder}/upper.xdmf", {"upper": 1})], comm,
+                              contact_pair=("upper", "upper"))
+    with pytest.raises(ValueError, match="does not exist"):
+        scene_from_xdmf_files([(f"{folder}/none.xdmf", {})], comm, contact_pair=("a", "b"))
+
