@@ -43,7 +43,7 @@ Units: mm, N, MPa. Positions and jumps [mm], tractions [MPa], forces [N], areas 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Optional, Sequence, Tuple, Union
 
 import basix
@@ -186,6 +186,7 @@ class _FacetGeometry:
         local_nodes = np.take_along_axis(
             dofs[self.cells], self.closure[self.local_facet], axis=1
         )
+        self.local_nodes = local_nodes                 # (n_f, n_close) local block indices
         self.global_nodes = V.dofmap.index_map.local_to_global(
             local_nodes.ravel().astype(np.int32)
         ).reshape(local_nodes.shape).astype(np.int64)
@@ -230,12 +231,21 @@ class ContactInterface:
         search_radius: for projection: the largest accepted distance between a first-surface
             point and its partner along the normal [mm], > 0; default: the largest facet
             diameter of the first surface. Points without partner within it are an error.
+        sliding: ``"small"`` (default: partners found once, at set-up — the paper's
+            kinematics) or ``"moderate"``: the projection is redone on the deformed surfaces
+            after every converged increment (:meth:`update_pairing`, called by
+            ``load_path``), so a body can slide over several elements of the other. Needs a
+            deformable second surface, the projection pairing (forced; not the mortar) and a
+            displacement space of the geometry's degree. See :meth:`update_pairing` for the
+            kinematics.
 
     Attributes:
         history: committed and trial law state and the accumulated dissipation
             (:class:`~rough_contact.interface.state.StatePair`).
         n_points, n_points_global: interface quadrature points on this rank / on all ranks.
-        pairing_used: ``"conforming"``, ``"projection"`` or ``"rigid"``.
+        pairing_used: ``"conforming"``, ``"projection"``, ``"mortar"`` or ``"rigid"``.
+        sliding: ``"small"`` or ``"moderate"``.
+        n_repairs: how many times :meth:`update_pairing` changed a partner facet.
         n_groups: pairs of (first facet, partner facet) on this rank: the element blocks
             assembled (= n_facets for conforming pairs and rigid obstacles).
 
@@ -262,6 +272,7 @@ class ContactInterface:
         match_tolerance: float = 1e-6,
         pairing: str = "auto",
         search_radius: Optional[float] = None,
+        sliding: str = "small",
     ):
         self.comm = V.mesh.comm
         self.V = V
@@ -285,6 +296,23 @@ class ContactInterface:
                              "'conforming', 'projection' or 'mortar'")
         if search_radius is not None:
             check_scalar("search_radius", search_radius, lo=0.0, unit="mm")
+        if sliding not in ("small", "moderate"):
+            raise ValueError(f"sliding = {sliding!r} is invalid: it must be 'small' or "
+                             "'moderate'")
+        if sliding == "moderate":
+            if second_tag is None or pairing not in ("auto", "projection"):
+                raise ValueError(
+                    f"sliding = 'moderate' needs a deformable second surface (second_tag) and "
+                    f"the projection pairing (pairing 'auto' or 'projection', got {pairing!r}, "
+                    f"second_tag {second_tag!r})")
+            if V.ufl_element().degree() != V.mesh.geometry.cmap.degree:
+                raise ValueError(
+                    f"sliding = 'moderate' needs a displacement space of the geometry's degree "
+                    f"({V.mesh.geometry.cmap.degree}), got {V.ufl_element().degree()}")
+            pairing = "projection"
+        self.sliding = sliding
+        self.n_repairs = 0
+        self._dirichlet = (None, list(bcs))
         self.first_tag, self.second_tag = first_tag, second_tag
         n_owned_facets = _facet_connectivity(V.mesh)
         rule = _FacetRule.create(V.mesh, degree, vertex=quadrature == "vertex")
@@ -318,6 +346,12 @@ class ContactInterface:
             if paired is None:
                 paired = self._project_second_surface(facet_tags, second_tag, n_owned_facets,
                                                       geo1, xq, R, search_radius)
+        if sliding == "moderate":   # what update_pairing needs
+            self._N1, self._nodes1, self._local_nodes1 = N1, geo1.global_nodes, geo1.local_nodes
+            self._R_full = R
+            self._partner_facet = paired.facet.reshape(-1).copy()
+            self._projection = None          # set-up pairing: rebuilt identically
+        self._matrix_keys: set = set()
         self._jump_operator(R, N1, geo1.global_nodes, paired)
         self._communication(bcs)
         self.history = self._initial_history()
@@ -473,18 +507,23 @@ class ContactInterface:
         comm = self.comm
         msh = self.V.mesh
         n_f, nq = xq.shape[:2]
-        element = self.V.element.basix_element
         second = _GatheredSurface.create(self.V, facet_tags, second_tag, n_owned_facets)
-        surface, owner2, lf2_all = second.surface, second.owner, second.local_facet
-        nodes2_all, n_close, closure = second.nodes, second.nodes.shape[1], second.closure
+        surface = second.surface
         if search_radius is None:
             vx1 = geo1.vertex_x
             diam = (np.linalg.norm(vx1[:, :, None] - vx1[:, None], axis=-1).max(initial=0.0)
                     if n_f else 0.0)
             search_radius = comm.allreduce(float(diam), op=MPI.MAX)
+        self.search_radius = search_radius
+        self._second = second
         x = xq.reshape(-1, 3)
         normal = R[..., 0, :].reshape(-1, 3)
         proj = project_points(x, normal, surface, _cmap_element(msh), search_radius)
+        self._check_partners(proj, x, search_radius, second_tag)
+        return self._partners(proj, (n_f, nq))
+
+    def _check_partners(self, proj, x, search_radius, second_tag, after=""):
+        comm = self.comm
         missing = proj.facet < 0
         n_missing = comm.allreduce(int(missing.sum()), op=MPI.SUM)
         if n_missing:
@@ -501,15 +540,21 @@ class ContactInterface:
                      f"{nearest:.6g} mm away" if np.isfinite(nearest) else
                      "no facet of the second surface lies on their normals")
             raise ValueError(
-                f"{n_missing} of {n_total} quadrature points of contact surface "
+                f"{after}{n_missing} of {n_total} quadrature points of contact surface "
                 f"{self.first_tag} have no partner on surface {second_tag} within the search "
                 f"radius {search_radius:.6g} mm along their normal; {why}{found}; first "
                 f"points: {first}. Check that the surfaces overlap and face each other, or "
                 "raise search_radius")
+
+    def _partners(self, proj, shape) -> _Partners:
+        """Partner data of a complete projection onto the gathered second surface."""
+        comm = self.comm
+        second = self._second
+        owner2, lf2_all, nodes2_all = second.owner, second.local_facet, second.nodes
+        n_close, closure = nodes2_all.shape[1], second.closure
         lf2 = lf2_all[proj.facet]
-        phi2 = tabulate(element, 0, proj.X_ref)[0]
+        phi2 = tabulate(self.V.element.basix_element, 0, proj.X_ref)[0]
         N2 = np.take_along_axis(phi2, closure[lf2], axis=1)
-        shape = (n_f, nq)
         self.n_remote_partners = int(np.sum(owner2[proj.facet] != comm.rank))
         return _Partners(N2=N2.reshape(shape + (n_close,)),
                          nodes2=nodes2_all[proj.facet].reshape(shape + (n_close,)),
@@ -669,6 +714,8 @@ class ContactInterface:
                                    axis=1)
             self._jump0[:, 0] += partners.gap0.reshape(-1)
             self.n_remote_partners = int(np.sum(partners.remote.reshape(-1)[first_point]))
+            self._group_keys = np.stack(
+                [group_facet, partners.facet.reshape(-1)[first_point]], axis=1)
             point_slot = np.empty(n_f * nq, dtype=np.int64)
             point_slot[own] = group * nqs + slot
             copies = np.flatnonzero(copy_of >= 0)
@@ -704,7 +751,7 @@ class ContactInterface:
         out[self._point_slot[own]] = values[own]   # slot-filling copies carry weight 0
         return out
 
-    def _communication(self, bcs) -> None:
+    def _communication(self, bcs, global_dofs=None) -> None:
         """One scatter for every DOF the owned facets touch; Dirichlet rows masked (collective)."""
         self._uniq, inv = np.unique(self._pair_dofs, return_inverse=True)
         self._inv = inv.reshape(self._pair_dofs.shape)
@@ -714,7 +761,7 @@ class ContactInterface:
         is_from = PETSc.IS().createGeneral(self._uniq.astype(PETSc.IntType), comm=MPI.COMM_SELF)
         self._scatter = PETSc.Scatter().create(template, is_from, self._loc, None)
         self._rows = self._pair_dofs.astype(PETSc.IntType)
-        self.set_dirichlet_dofs(None, bcs)
+        self.set_dirichlet_dofs(global_dofs, bcs)
 
     def _initial_history(self) -> StatePair:
         """The law's virgin state, checked against the LawState contract (collective)."""
@@ -744,6 +791,7 @@ class ContactInterface:
             global_dofs: global scalar DOF indices owned by this rank (each rank passes its own).
             bcs: dolfinx DirichletBC objects of V (their owned DOFs are added).
         """
+        self._dirichlet = (global_dofs, list(bcs))   # re-applied after a re-pairing
         marker = self._template.duplicate()
         marker.set(0.0)
         r0 = marker.getOwnershipRange()[0]
@@ -838,7 +886,95 @@ class ContactInterface:
         A.setLGMap(lgmap, lgmap)
         A.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, True)
         A.zeroEntries()
+        if self.sliding == "moderate":     # the (first facet, partner facet) blocks it holds
+            self._matrix_keys = {tuple(k) for k in self._group_keys.tolist()}
         return A
+
+    # ------------------------------------------------------------------ moderate sliding
+    def update_pairing(self, u: dolfinx.fem.Function) -> bool:
+        """Project the first surface's points again, on the surfaces deformed by ``u``
+        (``sliding="moderate"``; collective; ``load_path`` calls it after every converged
+        increment).
+
+        Kinematics (decision): every point keeps its place on the first surface, its frame
+        (the reference normal and axes: small rotations) and its law state. Its current
+        position x1 = X1 + u1 is projected along its normal onto the second surface at its
+        current position X2 + u2 (exact on P2 faces). The new partner carries the jump on:
+        the normal gap becomes the geometric distance found by the projection (the surface
+        under the point may have changed), the tangential jump is kept continuous (the
+        friction law's elastic slip and plastic slip are unaffected by the change of partner);
+        from then on tangential jump increments are relative displacements against the new
+        partner. With small sliding instead the point stays bound to the material point of
+        the other body it faced at set-up.
+
+        Returns:
+            True when a point found a partner facet whose block the Jacobian pattern lacks:
+            the caller rebuilds the matrices (``ContactProblem.rebuild_matrices``).
+
+        Raises:
+            ValueError: points that slid off the second surface (no partner within the
+                search radius), on every rank.
+        """
+        if self.sliding != "moderate":
+            raise ValueError("update_pairing needs sliding = 'moderate'")
+        msh = self.V.mesh
+        u_arr = u.x.array.reshape(-1, 3)
+        n_f, nq, n_close = self._N1.shape
+        jump_old = self.jump(u)
+        x1 = self._x + np.einsum("fqk,fki->fqi", self._N1,
+                                 u_arr[self._local_nodes1]).reshape(-1, 3)
+        sec = self._second
+        u2 = self.comm.allgather(u_arr[sec.own_local_nodes])
+        u2 = np.concatenate(u2).reshape(-1, n_close, 3) if u2 else np.zeros((0, n_close, 3))
+        cell_x = sec.surface.cell_x.copy()
+        rows = np.arange(cell_x.shape[0])[:, None]
+        cell_x[rows, sec.closure[sec.local_facet]] += u2   # Lagrange: facet = its closure
+        nv = sec.vertex_x.shape[1]
+        surface = _facet_set(msh, cell_x, sec.local_facet, sec.vertex_x + u2[:, :nv])
+        proj = project_points(x1, self._R[:, 0, :], surface, _cmap_element(msh),
+                              self.search_radius)
+        self._check_partners(proj, x1, self.search_radius, self.second_tag,
+                             after="after sliding: ")
+        return self._set_pairing(proj, jump_old, u)
+
+    def pairing_state(self) -> Optional[dict]:
+        """The current partners and jump offsets (moderate sliding; for checkpoints), or None
+        for small sliding (the pairing is rebuilt identically at set-up)."""
+        if self.sliding != "moderate":
+            return None
+        return dict(projection=self._projection, jump0=self._jump0.copy())
+
+    def restore_pairing(self, state: Optional[dict], u: dolfinx.fem.Function) -> bool:
+        """Reinstate :meth:`pairing_state` (collective). Returns True: rebuild the matrices."""
+        if state is None or state["projection"] is None:
+            return False
+        self._set_pairing(state["projection"], None, u)
+        self._jump0 = np.array(state["jump0"])
+        return True
+
+    def _set_pairing(self, proj, jump_old, u) -> bool:
+        n_f, nq, _ = self._N1.shape
+        partners = self._partners(proj, (n_f, nq))
+        moved = self.comm.allreduce(int(np.any(partners.facet.reshape(-1) !=
+                                               self._partner_facet)), op=MPI.SUM)
+        self._jump0 = np.zeros((n_f * nq, 3))
+        self._jump_operator(self._R_full, self._N1, self._nodes1,
+                            replace(partners, gap0=np.zeros((n_f, nq))))
+        global_dofs, bcs = self._dirichlet
+        self._communication(bcs, global_dofs)
+        if jump_old is not None:
+            raw = self._jump_of(self._pair_values(u))
+            jump0 = jump_old - raw                  # tangential jump continuous
+            jump0[:, 0] = proj.distance - raw[:, 0]  # normal: the geometric gap now
+            self._jump0 = jump0
+        self._projection = proj
+        self._partner_facet = partners.facet.reshape(-1).copy()
+        self._cache_valid = False
+        self._last = None
+        if moved:
+            self.n_repairs += 1
+        new = {tuple(k) for k in self._group_keys.tolist()} - self._matrix_keys
+        return bool(self.comm.allreduce(bool(new), op=MPI.LOR))
 
     # ------------------------------------------------------------------ evaluation
     def _pair_values(self, u: Union[dolfinx.fem.Function, PETSc.Vec]) -> np.ndarray:
@@ -1139,6 +1275,8 @@ class _GatheredSurface:
         nodes: (n2, n_close) global block indices of each facet's closure DOFs.
         vertex_x: (n2, nv, 3) vertex coordinates.
         closure: (n_lf, n_close) closure DOFs of every local facet of the element.
+        own_local_nodes: (n_own, n_close) local block indices of the closure DOFs of this
+            rank's facets (they come first-to-last in rank order in the gathered arrays).
     """
 
     surface: SecondSurface
@@ -1147,6 +1285,7 @@ class _GatheredSurface:
     nodes: np.ndarray
     vertex_x: np.ndarray
     closure: np.ndarray
+    own_local_nodes: np.ndarray
 
     @classmethod
     def create(cls, V, facet_tags, tag: int, n_owned_facets: int) -> _GatheredSurface:
@@ -1162,7 +1301,8 @@ class _GatheredSurface:
         return cls(surface=_facet_set(V.mesh, np.concatenate([g[0] for g in gathered]), lf, vx),
                    owner=owner, local_facet=lf,
                    nodes=np.concatenate([g[2] for g in gathered]).reshape(-1, n_close),
-                   vertex_x=vx, closure=geo.closure)
+                   vertex_x=vx, closure=geo.closure,
+                   own_local_nodes=np.asarray(geo.local_nodes, dtype=np.int64))
 
 
 @dataclass(frozen=True)

@@ -340,14 +340,13 @@ class ContactProblem:
         self.seating_stiffness = check_scalar("seating_stiffness", seating_stiffness, lo=0.0,
                                               lo_open=False, unit="MPa/mm")
         self.M_seat = None
+        self._seat_form = None
         if seating_tag is not None and self.seating_stiffness > 0.0:
             k_seat = fem.Constant(msh, self.seating_stiffness)
             m = fem.form(k_seat * ufl.inner(u, v) * ds(seating_tag))
             # On the pattern of K (a superset), so it can be added with SAME_NONZERO_PATTERN.
-            self.M_seat = self.K.duplicate(copy=False)
-            self.M_seat.zeroEntries()
-            fem_petsc.assemble_matrix(self.M_seat, m, bcs=self.bcs, diagonal=0.0)
-            self.M_seat.assemble()
+            self._seat_form = m
+            self._assemble_seating()
         self.seating_active = False
 
         # Initial iterate satisfies the Dirichlet values.
@@ -380,6 +379,28 @@ class ContactProblem:
         self.timings["bulk"] += t1 - t0
         self.timings["interface_residual"] += t2 - t1
         self.counters["residual"] += 1
+
+    def _assemble_seating(self) -> None:
+        self.M_seat = self.K.duplicate(copy=False)
+        self.M_seat.zeroEntries()
+        fem_petsc.assemble_matrix(self.M_seat, self._seat_form, bcs=self.bcs, diagonal=0.0)
+        self.M_seat.assemble()
+
+    def rebuild_matrices(self) -> None:
+        """New bulk matrix K and Jacobian A (and seating matrix) with the interface's current
+        pattern: after a re-pairing (moderate sliding) that needs blocks the old pattern lacks.
+        The near-nullspace carries over; the solver notices the new ``A`` (collective)."""
+        ns = self.A.getNearNullSpace()
+        self.K = self.interface.create_matrix(self.a)
+        self.K.zeroEntries()
+        fem_petsc.assemble_matrix(self.K, self.a, bcs=self.bcs)
+        self.K.assemble()
+        self.A = self.K.duplicate(copy=False)
+        if self._seat_form is not None:
+            self._assemble_seating()
+        if ns.handle:
+            self.K.setNearNullSpace(ns)
+            self.A.setNearNullSpace(ns)
 
     def J(self, snes, x: PETSc.Vec, A: PETSc.Mat, P: PETSc.Mat) -> None:
         """Consistent Jacobian ``K + dR_c/du`` (plus the seating spring while nothing touches)."""

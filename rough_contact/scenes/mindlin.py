@@ -116,6 +116,10 @@ class ParaboloidIndenter:
         return g, np.broadcast_to(np.array([0.0, 0.0, -1.0]), x.shape).copy()
 
 
+KT_SCALE = 3.75
+"""Default tangential penalty k_T = KT_SCALE E / h at contact element size h (see :func:`run`)."""
+
+
 def _program(preload_steps: int, shear_steps: int, cycles: int) -> LoadProgram:
     """``normal`` ramps to 1 over t in [0, 1]; ``shear``: monotonic 0 -> 1 over [1, 2]
     (``cycles`` = 0) or triangle cycles 0 -> 1 -> -1 -> 0 of unit length (``shear_steps`` per
@@ -140,13 +144,22 @@ def _program(preload_steps: int, shear_steps: int, cycles: int) -> LoadProgram:
 
 def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5, nu=0.49,
         mu=0.3, penalty=1e8, half_width=4.0, height=4.0, mesh_size=1.0, preload_steps=2,
-        shear_steps=12, cycles=0, indenter="paraboloid", comm=MPI.COMM_WORLD,
-        verbose=False) -> dict:
+        shear_steps=12, cycles=0, indenter="paraboloid", quadrature_degree=None,
+        k_tangential=None, comm=MPI.COMM_WORLD, verbose=False) -> dict:
     """Normal indentation by ``delta`` [mm], then a tangential bottom displacement: monotonic to
     ``slide`` [mm] (``cycles`` = 0) or ``cycles`` triangle cycles of amplitude ``slide``.
 
     ``indenter``: ``"paraboloid"`` (:class:`ParaboloidIndenter`, the closed forms'
     kinematics) or ``"sphere"`` (the exact rigid sphere).
+
+    ``penalty``: the normal penalty [MPa/mm]. ``k_tangential``: the tangential one; default
+    ``KT_SCALE * E / contact_size`` (3.75 E / h: the elastic slip at the peak pressure is
+    about 0.14 % of the element size). A tangential penalty that does not scale with the mesh
+    spoils the stick zone: too stiff (1e8 MPa/mm at h = a/8) over-constrains the tangential
+    jump at the many quadrature points per node and makes edge points with little pressure
+    slip under the normal load alone (c/a 3 % small at every level); too soft (1e7 at a/8)
+    adds its compliance and delays slip (c/a up to 4 % large). docs/mindlin.md has the study.
+    ``quadrature_degree``: of the facet rule (default 2 ``order``).
 
     ``slide`` defaults to the approach at which Mindlin's Q reaches mu P for Hertz's P at
     ``delta`` plus the block's shear compliance (so the last increments slide).
@@ -175,14 +188,18 @@ def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5
     V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", order))
     sym = fem.dirichletbc(PETSc.ScalarType(0.0), fem.locate_dofs_topological(
         V.sub(1), 2, scene.facet_tags.find(scene.tag("symmetry_y"))), V.sub(1))
-    law = SoftplusPenalty(penalty, 1e-3 * delta, k_tangential=penalty, friction=mu)
+    if k_tangential is None:
+        k_tangential = KT_SCALE * E / contact_size
+    check_scalar("k_tangential", k_tangential, lo=0.0, unit="MPa/mm")
+    law = SoftplusPenalty(penalty, 1e-3 * delta, k_tangential=k_tangential, friction=mu)
     if indenter not in ("paraboloid", "sphere"):
         raise ValueError(f"indenter = {indenter!r} is invalid: 'paraboloid' or 'sphere'")
     rigid = ParaboloidIndenter(radius) if indenter == "paraboloid" else \
         RigidSphere((0.0, 0.0, radius), radius)
     ci = ContactInterface(V, scene.facet_tags, scene.tag("contact"), law=law,
                           rigid=rigid, bcs=[sym],
-                          quadrature_degree=2 * order, grain_direction=(1.0, 0.0, 0.0))
+                          quadrature_degree=2 * order if quadrature_degree is None
+                          else quadrature_degree, grain_direction=(1.0, 0.0, 0.0))
     bottom = scene.tag("bottom")
     prog = _program(preload_steps, shear_steps, cycles)
     problem = ContactProblem(

@@ -102,7 +102,8 @@ def write_checkpoint(directory: str, problem, state: CheckpointState, sig: dict,
     data = dict(u=problem.u.x.array.copy(), u_previous=state.u_previous,
                 committed=None if ci is None else ci.history.committed,
                 dissipated=None if ci is None else ci.history.dissipated,
-                outputs=[o.checkpoint_state() for o in outputs])
+                outputs=[o.checkpoint_state() for o in outputs],
+                pairing=None if ci is None else ci.pairing_state())
     with open(os.path.join(path, f"rank{comm.rank}.pkl"), "wb") as f:
         pickle.dump(data, f, protocol=pickle.HIGHEST_PROTOCOL)
         f.flush()
@@ -189,6 +190,8 @@ def read_checkpoint(directory: str, problem, factors,
     if ci is not None:
         ci.history.restore(data["committed"], data["dissipated"])
         ci.revert()
+        if ci.restore_pairing(data.get("pairing"), problem.u):   # moderate sliding
+            problem.rebuild_matrices()
     for writer, saved in zip(outputs, saved_outputs):
         writer.restore(saved)
     return CheckpointState(step=meta["step"], index=meta["index"], delta=meta["delta"],

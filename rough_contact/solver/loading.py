@@ -211,6 +211,15 @@ def _print_increment(inc: Increment) -> None:
     )
 
 
+def _update_pairing(problem: ContactProblem) -> None:
+    """Moderate sliding: pair the surfaces again on the converged configuration before the
+    next increment (after the increment was reported and checkpointed with its own pairing)."""
+    interface = problem.interface
+    if interface is not None and interface.sliding == "moderate":
+        if interface.update_pairing(problem.u):
+            problem.rebuild_matrices()
+
+
 def load_path(problem: ContactProblem, solver: SNESSolver, factors: Iterable[float], *,
               min_increment: float = 1e-4, max_growth: float = 2.0,
               verbose: bool = True, validity: str = "warn",
@@ -289,6 +298,7 @@ def load_path(problem: ContactProblem, solver: SNESSolver, factors: Iterable[flo
     done = 0
     if resume is not None:
         restored = read_checkpoint(resume, problem, factors, outputs)
+        _update_pairing(problem)   # the checkpoint holds the pairing its increment used
     sig = None if checkpoint is None else checkpoint_signature(problem)
     _check_initial_guess(problem)
     interface = problem.interface
@@ -373,6 +383,7 @@ def load_path(problem: ContactProblem, solver: SNESSolver, factors: Iterable[flo
                 yield inc
                 if checkpoint is not None:
                     write_checkpoint(checkpoint, problem, saved, sig, outputs)
+                _update_pairing(problem)
                 done += 1
                 if max_steps is not None and done >= max_steps:
                     return

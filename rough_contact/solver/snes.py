@@ -237,6 +237,7 @@ class SNESSolver:
         self.x = problem.u.vector.copy()
         self.snes.setFunction(problem.F, problem.b)
         self.snes.setJacobian(problem.J, problem.A)
+        self._A = problem.A        # a re-pairing may replace it (problem.rebuild_matrices)
         with self._options():
             self.snes.setFromOptions()
         self._atol0 = self.snes.getTolerances()[1]
@@ -282,6 +283,9 @@ class SNESSolver:
                 failures of the linear solver come back as a negative converged reason).
         """
         self._residuals = []
+        if self.problem.A is not self._A:          # new pattern after a re-pairing
+            self.snes.setJacobian(self.problem.J, self.problem.A)
+            self._A = self.problem.A
         self.problem.u.vector.copy(self.x)
         if self._auto_atol:
             # Round-off floor of F = K u - f: about eps |K|_inf |u|_inf. Below it Newton cannot

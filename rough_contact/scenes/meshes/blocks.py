@@ -42,7 +42,7 @@ from rough_contact.fem.mesh import (Scene, add_groups, build_scene, entity_cente
                                     validate_order, validate_positive)
 
 __all__ = ["two_blocks", "separate_blocks", "block_on_plane", "indented_block",
-           "sphere_on_block", "cylinder_on_block"]
+           "sphere_on_block", "cylinder_on_block", "slider_on_slab"]
 
 
 def _side_groups(model, lx, ly, tol):
@@ -184,6 +184,71 @@ def separate_blocks(lx: float = 1.0, ly: float = 1.0, h1: float = 1.0, h2: float
         surface_owners={"contact_upper": "upper", "contact_lower": "lower"},
         dimensions=dict(lx=lx, ly=ly, h1=h1, h2=h2, size_lower=size_lower,
                         size_upper=size_upper))
+
+
+def slider_on_slab(slab_length: float = 3.0, slider_length: float = 1.0, width: float = 0.5,
+                   h_slab: float = 0.5, h_slider: float = 0.5, size_slab: float = 0.125,
+                   size_slider: float = 0.1, order: int = 1,
+                   comm: MPI.Comm = MPI.COMM_WORLD) -> Scene:
+    """A short block (the slider) on a long one (the slab), meshed independently with
+    structured hexahedra, both centred on x = 0, y in [0, width]: the scene of a body sliding
+    over several elements of the other (moderate sliding). Collective.
+
+    Groups: bodies ``slider`` (1), ``slab`` (2); ``contact_slider`` (11, first),
+    ``contact_slab`` (12), ``top`` (13, slider top), ``bottom`` (14, slab bottom),
+    ``y0_slider`` (15), ``y0_slab`` (16).
+    """
+    validate_positive(slab_length=slab_length, slider_length=slider_length, width=width,
+                      h_slab=h_slab, h_slider=h_slider, size_slab=size_slab,
+                      size_slider=size_slider)
+    validate_order(order)
+    if slider_length >= slab_length:
+        raise ValueError(f"slider_length = {slider_length} must be < slab_length = "
+                         f"{slab_length}")
+    tol = 1e-6 * max(slab_length, h_slab, h_slider)
+
+    def build(model):
+        slab = model.occ.addBox(-slab_length / 2, 0, -h_slab, slab_length, width, h_slab)
+        slider = model.occ.addBox(-slider_length / 2, 0, 0, slider_length, width, h_slider)
+        model.occ.synchronize()   # no fragment: two independent surface meshes on z = 0
+        add_groups(model, 3, {"slider": (1, [slider]), "slab": (2, [slab])})
+        faces = {v: [t for _, t in model.getBoundary([(3, v)], oriented=False)]
+                 for v in (slab, slider)}
+        tags, c = entity_centers(model, 2)
+        z, y = c[:, 2], c[:, 1]
+
+        def pick(vol, mask):
+            return [t for t in faces[vol] if t in set(tags[mask].tolist())]
+
+        add_groups(model, 2, {
+            "contact_slider": (11, pick(slider, np.abs(z) < tol)),
+            "contact_slab": (12, pick(slab, np.abs(z) < tol)),
+            "top": (13, pick(slider, np.abs(z - h_slider) < tol)),
+            "bottom": (14, pick(slab, np.abs(z + h_slab) < tol)),
+            "y0_slider": (15, pick(slider, np.abs(y) < tol)),
+            "y0_slab": (16, pick(slab, np.abs(y) < tol))})
+        for vol, size in ((slab, size_slab), (slider, size_slider)):
+            edges = model.getBoundary([(2, f) for f in faces[vol]], combined=False,
+                                      oriented=False)
+            for curve in sorted({abs(t) for _, t in edges}):
+                a, b = model.getBoundary([(1, curve)], combined=False, oriented=False)
+                length = np.linalg.norm(np.subtract(model.getValue(0, a[1], []),
+                                                    model.getValue(0, b[1], [])))
+                model.mesh.setTransfiniteCurve(curve, 1 + max(1, int(np.ceil(
+                    length / size - 1e-9))))
+        for dim, surface in model.getEntities(2):
+            model.mesh.setTransfiniteSurface(surface)
+            model.mesh.setRecombine(dim, surface)
+        for _, volume in model.getEntities(3):
+            model.mesh.setTransfiniteVolume(volume)
+        generate(model, order)
+
+    return build_scene(
+        comm, "slider_on_slab", build, split_body="slider",
+        contact_pair=("contact_slider", "contact_slab"),
+        surface_owners={"contact_slider": "slider", "contact_slab": "slab"},
+        dimensions=dict(slab_length=slab_length, slider_length=slider_length, width=width,
+                        h_slab=h_slab, h_slider=h_slider))
 
 
 def sphere_on_block(radius: float = 10.0, cap_height: float = 1.0, half_width: float = 4.0,
