@@ -34,12 +34,18 @@ def gross_slide():
     return 3 * MU * P * (2 - NU) / (16 * G * a) + MU * P * 4.0 / (G * 2 * 16.0)
 
 
-def stick(levels):
+def _kt(h, kt, kt_scale):
+    """The tangential penalty at element size h: fixed, or kt_scale E / h."""
+    return kt_scale * E / h if kt_scale else kt
+
+
+def stick(levels, kt=None, kt_scale=None):
     PETSc.Sys.Print(f"{'h':>6} {'h/a':>5} {'DOFs':>7} {'Q/muP':>6} {'c/a FE':>7} {'c/a MD':>7} "
                     f"{'error':>7} {'Newton':>6} {'time s':>6}")
     for h in levels:
         t0 = time.perf_counter()
-        r = mindlin.run(contact_size=h, order=2, nu=NU, mu=MU)
+        r = mindlin.run(contact_size=h, order=2, nu=NU, mu=MU,
+                        k_tangential=_kt(h, kt, kt_scale))
         dt = time.perf_counter() - t0
         q = r["Q"] / (MU * r["P"])
         for i in np.flatnonzero((q > 0.01) & (q < 0.99)):
@@ -49,7 +55,7 @@ def stick(levels):
                             f"{int(r['newton'].sum()):6d} {dt:6.0f}")
 
 
-def energy(levels, amplitudes):
+def energy(levels, amplitudes, kt=None, kt_scale=None):
     PETSc.Sys.Print(f"{'h':>6} {'DOFs':>7} {'ampl':>5} {'Q*/muP':>6} {'W FE':>10} {'loop':>10} "
                     f"{'W MD':>10} {'error':>7} {'Newton':>6} {'time s':>6}")
     G = E / (2 * (1 + NU))
@@ -57,7 +63,7 @@ def energy(levels, amplitudes):
         for amp in amplitudes:
             t0 = time.perf_counter()
             r = mindlin.run(contact_size=h, order=2, nu=NU, mu=MU, slide=amp * gross_slide(),
-                            cycles=2, shear_steps=16)
+                            cycles=2, shear_steps=16, k_tangential=_kt(h, kt, kt_scale))
             t, s, Q, D = r["t"], r["slide"], r["Q"], r["dissipation"]
             end1 = int(np.argmin(np.abs(t - 2.0)))
             idx = np.arange(end1, t.size)
@@ -75,11 +81,16 @@ def main(argv=None):
     ap.add_argument("--levels", type=float, nargs="+", default=[0.05, 0.025])
     ap.add_argument("--part", choices=["stick", "energy", "all"], default="all")
     ap.add_argument("--amplitudes", type=float, nargs="+", default=[0.5])
+    ap.add_argument("--k-tangential", type=float, default=None,
+                    help="tangential penalty [MPa/mm] (default: the normal one, 1e8)")
+    ap.add_argument("--kt-scale", type=float, default=None,
+                    help="tangential penalty k_T = KT_SCALE * E / h at element size h "
+                    "(overrides --k-tangential)")
     args = ap.parse_args(argv)
     if args.part in ("stick", "all"):
-        stick(args.levels)
+        stick(args.levels, args.k_tangential, args.kt_scale)
     if args.part in ("energy", "all"):
-        energy(args.levels, args.amplitudes)
+        energy(args.levels, args.amplitudes, args.k_tangential, args.kt_scale)
 
 
 if __name__ == "__main__":

@@ -6,10 +6,11 @@ What the coarse level (block elements a/4 at the contact, P2) must already show,
 closed forms: the normal force does not change while sliding (decoupling), the tangential force
 never exceeds mu P and reaches it in gross slip (Coulomb's bound, to the penalty's elastic
 slip), the stick ratio falls with Q as (1 - Q / mu P)^(1/3) within the coarse level's
-discretisation error. Measured (12 slide increments): at a/4 the stick ratio is 6-9 % small
-for Q / mu P < 0.7 (12-17 % at 0.8-0.95), at a/8 3-5 % (6 % at 0.95): first order in the
-element size (docs/mindlin.md, benchmarks/bench_mindlin.py). Asserted here: 10 % for
-0.05 < Q / mu P < 0.7 at a/4.
+discretisation error. Measured with the default tangential penalty scaled with the mesh
+(k_T = 3.75 E / h; 12 slide increments, docs/mindlin.md, benchmarks/bench_mindlin.py): at a/4
+the stick ratio is within 1.5 % for Q / mu P < 0.9 (3 % at 0.93-0.98), at a/8 within 2 % for
+Q / mu P < 0.95. Asserted here: 3 % for 0.05 < Q / mu P < 0.9 at a/4. (With k_T = 1e8 MPa/mm,
+not scaled, the same level is 6-9 % small: the edge points slip under the normal load alone.)
 """
 
 from __future__ import annotations
@@ -28,7 +29,8 @@ def test_cattaneo_mindlin_coarse():
     assert np.all(q <= 1.0 + 1e-9)
     assert q[-1] > 0.99                           # gross slip at the default slide
     assert np.all(np.diff(q[preload - 1:]) > 0) and np.all(np.diff(stick[preload - 1:]) < 0)
-    partial = (q > 0.05) & (q < 0.7)
-    assert partial.sum() >= 2
+    assert stick[preload - 1] > 0.97              # 0.93 with the unscaled k_T = 1e8 MPa/mm
+    partial = (q > 0.05) & (q < 0.9)
+    assert partial.sum() >= 3
     ref = mindlin.stick_ratio(Q[partial], r["mu"], P[partial])
-    assert np.all(np.abs(stick[partial] / ref - 1.0) < 0.10)
+    assert np.all(np.abs(stick[partial] / ref - 1.0) < 0.03)
