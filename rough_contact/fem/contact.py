@@ -1095,6 +1095,15 @@ class ContactInterface:
         f = np.einsum("pai,pa,p->i", self._R, res.traction, self._weights)
         return self.comm.allreduce(f, op=MPI.SUM)
 
+    def interface_stiffness(self) -> np.ndarray:
+        """(3,) the interface's tangent stiffness summed over its area, in local axes
+        (normal, x, y): int dt_i/djump_i dA [N/mm] at the last evaluation (collective). For a
+        flat joint these are its normal and tangential interface stiffnesses (the bodies'
+        compliance not included)."""
+        res = self._result()
+        k = np.einsum("pii,p->i", res.tangent, self._weights)
+        return self.comm.allreduce(k, op=MPI.SUM)
+
     def real_contact_area(self) -> float:
         """int A/A0 dA over the interface [mm^2] (collective)."""
         res = self._result()

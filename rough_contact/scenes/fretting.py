@@ -56,7 +56,9 @@ def run_amplitude(amplitude_um: float, *, size=2.0, height=1.0, mesh_size=0.5, o
     and the dissipation). ``checkpoint``: directory receiving a checkpoint per increment (with
     the rows); ``restart``: such a directory to continue from (the rows and ``loop_csv``
     continue); ``stop_after``: stop after this many increments (the result then covers them
-    only). ``solved`` in the result: the increments solved by this call.
+    only). ``solved`` in the result: the increments solved by this call; ``k_normal``,
+    ``k_tangential``: the interface's normal and tangential stiffness at the end of the preload
+    (int dp/dg dA, int dt_x/ds_x dA [N/mm]; NaN when a restart skipped the preload).
     """
     a = check_scalar("amplitude", amplitude_um, lo=0.0, unit="um") * 1e-3
     check_scalar("pressure", pressure, lo=0.0, unit="MPa")
@@ -83,18 +85,21 @@ def run_amplitude(amplitude_um: float, *, size=2.0, height=1.0, mesh_size=0.5, o
     solver = SNESSolver(problem, prefix="fret_")
     rec = CsvRecorder(loop_csv, LOOP_COLUMNS, comm)
     solved = 0
+    k_interface = np.full(3, np.nan)          # stays NaN when restarted past the preload
     for inc in load_path(problem, solver, prog.times, verbose=verbose, checkpoint=checkpoint,
                          resume=restart, outputs=[rec], max_steps=stop_after):
         rec.add((inc.load_factor, problem.scales["cyclic"] * a, problem.reaction(top)[0],
                  inc.contact_force[2], inc.dissipation, inc.n_slipping, inc.n_points,
                  inc.newton_total))
         solved += 1
+        if abs(inc.load_factor - 1.0) < 1e-12:         # end of the preload
+            k_interface = ci.interface_stiffness()
     solver.destroy()
     t, u, fx, fz, d, slip, npts, its = rec.array().T
     return dict(amplitude_um=amplitude_um, force=force, dofs=problem.num_dofs, t=t, u=u, fx=fx,
                 fz=fz, dissipation=d, slipping=slip.astype(int), n_points=npts.astype(int),
                 newton=int(its.sum()), cycles=cycle_summary(t, prog, u, fx, d), normal=normal,
-                solved=solved)
+                solved=solved, k_normal=float(k_interface[0]), k_tangential=float(k_interface[1]))
 
 
 def run(amplitudes_um=(0.3, 0.5, 0.7, 1.0, 2.0, 4.0), outdir="results/fretting", plot=True,
@@ -116,6 +121,10 @@ def run(amplitudes_um=(0.3, 0.5, 0.7, 1.0, 2.0, 4.0), outdir="results/fretting",
                           loop_csv=os.path.join(outdir, f"loop_a{amp:g}um.csv"), **kwargs)
         normal = r["normal"]
         last = r["cycles"][-1]
+        if not results:
+            PETSc.Sys.Print(f"  preloaded joint: interface normal stiffness {r['k_normal']:.4e} "
+                            f"N/mm, tangential {r['k_tangential']:.4e} N/mm (before slip)",
+                            comm=comm)
         PETSc.Sys.Print(f"  a = {amp:8.4g} um: {r['dofs']} DOFs, Newton {r['newton']}, energy per "
                         f"cycle {last['loop_energy']:.4e} N mm (interface {last['dissipated']:.4e}), "
                         f"secant stiffness {last['secant_stiffness']:.4e} N/mm, max |Fx|/P "

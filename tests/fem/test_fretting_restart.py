@@ -56,3 +56,21 @@ def test_driver_restart_reads_finished_amplitudes(tmp_path):
     assert again[1]["dissipation"][-1] > again[0]["dissipation"][-1]
     with pytest.raises(ValueError, match="max_steps = 0 is invalid"):
         fretting.run_amplitude(0.5, stop_after=0, **SMALL)
+
+
+def test_interface_stiffness_of_a_linear_penalty():
+    """The joint's interface stiffness the fretting scene reports (ContactInterface.
+    interface_stiffness) is int dt/djump dA: for a bilateral linear penalty k_N, k_T on a flat
+    2 x 2 mm interface it is (k_N, k_T, k_T) x 4 mm^2 (non-matching meshes, mortar pairing)."""
+    from dolfinx import fem
+
+    from rough_contact.fem.contact import ContactInterface
+    from rough_contact.interface.penalty import LinearPenalty
+    from rough_contact.scenes.meshes.blocks import separate_blocks
+
+    scene = separate_blocks(lx=2.0, ly=2.0, size_lower=0.5, size_upper=0.7)
+    V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", 1))
+    ci = ContactInterface(V, scene.facet_tags, *scene.contact_pair,
+                          law=LinearPenalty(3e4, k_tangential=1e4), pairing="mortar")
+    ci.evaluate(fem.Function(V))
+    np.testing.assert_allclose(ci.interface_stiffness(), [1.2e5, 4e4, 4e4], rtol=1e-12)
