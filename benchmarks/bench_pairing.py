@@ -2,6 +2,7 @@
 
     OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bench_pairing.py [--part accuracy|cost|all]
         [--points 10000 50000 200000] [--pairings conforming projection mortar moderate]
+    ... --part newton [--points 10000 50000]  (also under mpirun -n 2)
 
 Part "accuracy": two blocks meshed independently (``separate_blocks``), uniform pressure
 p = 80 MPa on top, bilateral linear penalty 1e6 MPa/mm, lower block E/2: largest pointwise
@@ -19,6 +20,12 @@ least the bulk assembly plus a linear solve, so the ratio is an upper bound of t
 share. "moderate" is the projection with ``sliding="moderate"``: its last column is the time of
 one ``update_pairing`` (projection on the deformed surfaces, new operator and scatter), paid once
 per increment. Serial. Units: mm, N, MPa, s.
+
+Part "newton": the interface's share of complete Newton iterations (residual and Jacobian
+assembly of the interface against the wall time of the whole solve: bulk copy, interface,
+linear solves) on blocks 1 x 1 x 0.25 mm of Q1 hexahedra (two layers each at equal sizes),
+80 MPa on top, Coulomb penalty mu = 0.3, one load step from rest with the default solver; and
+for "moderate" the time of one re-pairing after it.
 """
 
 from __future__ import annotations
@@ -147,9 +154,60 @@ def cost(points, only=None):
                 b.destroy()
 
 
+def newton(points, only=None):
+    """Interface share of real Newton iterations: two blocks 1 x 1 x 0.25 mm (Q1, 2 element
+    layers each), 80 MPa on top, lower bottom on rollers, rough-free Coulomb penalty (mu = 0.3),
+    solved at full load from rest with the default linear solver."""
+    PETSc.Sys.Print("\nNewton iterations (Q1, 4 points per first facet, Coulomb penalty, "
+                    f"{MPI.COMM_WORLD.size} rank(s))")
+    PETSc.Sys.Print(f"{'target':>7} {'meshes':>6} {'pairing':>10} {'points':>8} {'DOFs':>8} "
+                    f"{'Newton':>6} {'total s':>7} {'bulk s':>7} {'iface s':>7} {'share':>6} "
+                    f"{'re-pair s':>9} {'solver':>14}")
+    for n_target in points:
+        n_side = int(round(np.sqrt(n_target / 4.0)))
+        for label, n_up in (("equal", n_side), ("5:7", int(round(n_side * 7 / 5)))):
+            for pairing in [p for p in ("projection", "mortar", "moderate")
+                            if only is None or p in only]:
+                scene = separate_blocks(h1=0.25, h2=0.25, size_lower=1.0 / n_side,
+                                        size_upper=1.0 / n_up, cell_type="hexahedron")
+                V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", 1))
+                bcs = [_roller(V, scene, "x0", 0), _roller(V, scene, "y0", 1),
+                       _roller(V, scene, "bottom", 2)]
+                law = SoftplusPenalty(1e6, 1e-6, k_tangential=1e6, friction=0.3)
+                ci = ContactInterface(V, scene.facet_tags, *scene.contact_pair, law=law,
+                                      bcs=bcs, pairing="projection" if pairing == "moderate"
+                                      else pairing,
+                                      sliding="moderate" if pairing == "moderate" else "small")
+                mats = {scene.tag("upper"): Material(E, NU),
+                        scene.tag("lower"): Material(0.5 * E, NU)}
+                problem = ContactProblem(V, mats, bcs, [SurfaceLoad(scene.tag("top"),
+                                                                    traction=[0, 0, -P])],
+                                         cell_tags=scene.cell_tags,
+                                         facet_tags=scene.facet_tags, interface=ci)
+                solver = SNESSolver(problem, prefix="bench_newton_")
+                problem.set_load_factor(1.0)
+                problem.reset_timings()
+                t0 = MPI.Wtime()
+                result = solver.solve()
+                total = MPI.Wtime() - t0
+                t = problem.timings
+                iface = t["interface_residual"] + t["interface_jacobian"]
+                t_re = float("nan")
+                if pairing == "moderate":
+                    t0 = MPI.Wtime()
+                    ci.update_pairing(problem.u)
+                    t_re = MPI.Wtime() - t0
+                PETSc.Sys.Print(f"{n_target:7d} {label:>6} {pairing:>10} "
+                                f"{ci.n_points_global:8d} {problem.num_dofs:8d} "
+                                f"{result.iterations:6d} {total:7.2f} {t['bulk']:7.2f} "
+                                f"{iface:7.2f} {iface / total:6.1%} {t_re:9.2f} "
+                                f"{solver.linear_solver:>14}")
+                solver.destroy()
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--part", choices=["accuracy", "cost", "all"], default="all")
+    ap.add_argument("--part", choices=["accuracy", "cost", "newton", "all"], default="all")
     ap.add_argument("--points", type=int, nargs="+", default=[10000, 50000, 200000])
     ap.add_argument("--pairings", nargs="+", default=None,
                     choices=["conforming", "projection", "mortar", "moderate"])
@@ -158,6 +216,8 @@ def main(argv=None):
         accuracy()
     if args.part in ("cost", "all"):
         cost(args.points, args.pairings)
+    if args.part in ("newton", "all"):
+        newton(args.points, args.pairings)
 
 
 if __name__ == "__main__":
