@@ -908,8 +908,9 @@ class ContactInterface:
         the other body it faced at set-up.
 
         Returns:
-            True when a point found a partner facet whose block the Jacobian pattern lacks:
-            the caller rebuilds the matrices (``ContactProblem.rebuild_matrices``).
+            True when the (first facet, partner facet) blocks changed: the caller rebuilds the
+            matrices (``ContactProblem.rebuild_matrices``) so that the Jacobian pattern is
+            exactly the current blocks' (a resumed run then reproduces the uninterrupted one).
 
         Raises:
             ValueError: points that slid off the second surface (no partner within the
@@ -973,8 +974,10 @@ class ContactInterface:
         self._last = None
         if moved:
             self.n_repairs += 1
-        new = {tuple(k) for k in self._group_keys.tolist()} - self._matrix_keys
-        return bool(self.comm.allreduce(bool(new), op=MPI.LOR))
+        # the pattern follows the current blocks exactly (not their history): a resumed run
+        # then assembles into the same pattern as the uninterrupted one, bit for bit
+        changed = {tuple(k) for k in self._group_keys.tolist()} != self._matrix_keys
+        return bool(self.comm.allreduce(changed, op=MPI.LOR))
 
     # ------------------------------------------------------------------ evaluation
     def _pair_values(self, u: Union[dolfinx.fem.Function, PETSc.Vec]) -> np.ndarray:
