@@ -140,10 +140,22 @@ def _figures(comm, pairing, order=2, fd=False):
                             comm=comm)
     V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", order))
     law = SoftplusPenalty(1e4, 1e-3, k_tangential=5e3, friction=0.2)
+    moderate = pairing == "moderate"
     ci = ContactInterface(V, scene.facet_tags, *scene.contact_pair, law=law,
-                          quadrature_degree=2 * order, pairing=pairing)
+                          quadrature_degree=2 * order,
+                          pairing="projection" if moderate else pairing,
+                          sliding="moderate" if moderate else "small")
     u = fem.Function(V)
     _interpolate_bodies(u, scene)
+    if moderate:    # the upper face slid by up to 0.07 mm (a quarter element), 0 at its
+        upper = scene.cell_tags.find(scene.tag("upper"))   # edges: it stays over the lower one
+        shift = fem.Function(V)
+        shift.interpolate(lambda x: np.stack([0.07 * np.sin(np.pi * x[0]), 0 * x[0], 0 * x[0]]),
+                          cells=upper)
+        u.x.array[:] += shift.x.array
+        u.x.scatter_forward()
+        ci.update_pairing(u)
+        assert ci.comm.allreduce(ci.n_repairs, op=MPI.MAX) == 1
     b = dolfinx.cpp.la.petsc.create_vector(V.dofmap.index_map, 3)
     b.set(0.0)
     ci.assemble_residual(u, b)
@@ -180,7 +192,7 @@ def _figures(comm, pairing, order=2, fd=False):
     return figs, fd_err
 
 
-@pytest.mark.parametrize("pairing", ["projection", "mortar"])
+@pytest.mark.parametrize("pairing", ["projection", "mortar", "moderate"])
 def test_rank_independent_and_jacobian(pairing):
     """Non-uniform state with friction: the same figures on all ranks and on one; the assembled
     Jacobian is the derivative of the assembled residual."""
