@@ -134,7 +134,8 @@ def test_demo_fretting(tmp_path):
     energy, lower secant stiffness); the CSV holds one row per amplitude and cycle."""
     ranks = 2 if MPIRUN else 1
     out = run([DEMOS / "demo_fretting.py", "--amplitudes", "0.3", "4", "--cycles", "1",
-               "--steps-per-cycle", "8", "--outdir", tmp_path / "fret"], tmp_path, ranks)
+               "--steps-per-cycle", "8", "--mesh-size", "0.5", "--outdir", tmp_path / "fret"],
+              tmp_path, ranks)
     assert "energy per cycle" in out
     import csv
 
