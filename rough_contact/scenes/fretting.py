@@ -41,6 +41,8 @@ from rough_contact.validation import check_scalar
 __all__ = ["run_amplitude", "run"]
 
 
+_SCENES: dict = {}   # meshes built by run_amplitude, per parameters and communicator
+
 LOOP_COLUMNS = ("pseudo_time", "u_x_mm", "F_x_N", "F_z_contact_N", "dissipation_Nmm",
                 "n_slipping", "n_points", "newton_its_spent")
 
@@ -62,8 +64,11 @@ def run_amplitude(amplitude_um: float, *, size=2.0, height=1.0, mesh_size=0.5, o
     """
     a = check_scalar("amplitude", amplitude_um, lo=0.0, unit="um") * 1e-3
     check_scalar("pressure", pressure, lo=0.0, unit="MPa")
-    scene = two_blocks(lx=size, ly=size, h1=height, h2=height, mesh_size=mesh_size, order=order,
-                       comm=comm)
+    key = (size, height, mesh_size, order, comm.py2f())
+    if key not in _SCENES:     # one build per process: the amplitudes and a resumed run share
+        _SCENES[key] = two_blocks(lx=size, ly=size, h1=height, h2=height,  # its partition
+                                  mesh_size=mesh_size, order=order, comm=comm)
+    scene = _SCENES[key]
     V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", order))
     clamp = fem.dirichletbc(np.zeros(3, dtype=PETSc.ScalarType), fem.locate_dofs_topological(
         V, 2, scene.facet_tags.find(scene.tag("bottom"))), V)

@@ -20,7 +20,9 @@ rank, then ``meta.json``); the file ``LATEST`` naming the complete slot is repla
 moment leaves ``LATEST`` pointing at a complete slot.
 
 Refused with a clear error: a directory without a checkpoint, a different number of ranks,
-another mesh or partition (DOF counts or a checksum of the DOF coordinates differ), another law
+another mesh (DOF count or a checksum of the DOF coordinates differ), another partition (a rank
+holds other DOFs than when the checkpoint was written: DOLFINx's partitioner can give another
+partition for a second build of the same mesh in one process), another law
 (type or number of interface points), or a load-factor list that does not match the saved one.
 """
 
@@ -100,6 +102,7 @@ def write_checkpoint(directory: str, problem, state: CheckpointState, sig: dict,
     comm.Barrier()
     ci = problem.interface
     data = dict(u=problem.u.x.array.copy(), u_previous=state.u_previous,
+                partition=_local_checksum(problem),
                 committed=None if ci is None else ci.history.committed,
                 dissipated=None if ci is None else ci.history.dissipated,
                 outputs=[o.checkpoint_state() for o in outputs],
@@ -129,6 +132,14 @@ def write_checkpoint(directory: str, problem, state: CheckpointState, sig: dict,
 def has_checkpoint(directory: str, comm: MPI.Comm = MPI.COMM_WORLD) -> bool:
     """Whether ``directory`` holds a complete checkpoint (collective: rank 0 decides)."""
     return bool(comm.bcast(_latest(directory) is not None if comm.rank == 0 else None, root=0))
+
+
+def _local_checksum(problem) -> np.ndarray:
+    """(count, checksum) of this rank's owned DOF coordinates."""
+    V = problem.V
+    n = V.dofmap.index_map.size_local
+    x = V.tabulate_dof_coordinates()[:n]
+    return np.array([float(n), float(np.round(x, 9).sum() + 7.0 * np.round(x ** 2, 9).sum())])
 
 
 def _latest(directory: str) -> Optional[str]:
@@ -175,9 +186,20 @@ def read_checkpoint(directory: str, problem, factors,
                               "load path")
     with open(os.path.join(path, f"rank{comm.rank}.pkl"), "rb") as f:
         data = pickle.load(f)
-    if data["u"].shape != problem.u.x.array.shape:
-        raise CheckpointError(f"rank {comm.rank}: {data['u'].shape[0]} local DOFs in the "
-                              f"checkpoint, {problem.u.x.array.shape[0]} in this problem")
+    # the same partition: every rank must hold the DOFs it held (a global checksum cannot see a
+    # permutation between ranks; DOLFINx's partitioner may differ between two mesh builds of one
+    # process)
+    mine_local = _local_checksum(problem)
+    same = (data["u"].shape == problem.u.x.array.shape
+            and np.allclose(data.get("partition", mine_local), mine_local, rtol=1e-12,
+                            atol=1e-9))
+    if not comm.allreduce(same, op=MPI.LAND):
+        bad = comm.allgather(None if same else comm.rank)
+        raise CheckpointError(
+            f"restart directory {directory!r}: the mesh is partitioned differently from the "
+            f"checkpointed run (rank(s) {[r for r in bad if r is not None]} hold other DOFs); "
+            "build the mesh the same way on the same number of ranks (a fresh process building "
+            "the same scenes in the same order does)")
     saved_outputs = data.get("outputs", [])
     if len(saved_outputs) != len(outputs):
         raise CheckpointError(f"the checkpoint in {directory!r} holds the state of "
