@@ -32,7 +32,7 @@ Sizes (quarter punch, tetrahedra, P2 unless noted):
     medium  P2, mesh 5 mm, contact 0.5 mm       (~88 k DOFs)
     large   P2, mesh 3.5 mm, contact 0.35 mm    (~228 k DOFs)
     huge    P2, mesh 2.1 mm, contact 0.21 mm    (~1 M DOFs; see docs/solver.md for memory)
-Custom: --custom MESH,CONTACT,ORDER (repeatable). Options -rc_* apply to every run (they are
+Custom: --custom MESH,CONTACT,ORDER[,tet|hex] (repeatable; hex: hexahedra, Q1/Q2). Options -rc_* apply to every run (they are
 copied to each run's own prefix). Units: mm, N, MPa.
 """
 
@@ -50,7 +50,7 @@ def parse_args(argv):
     parser.add_argument("--sizes", nargs="*", default=["small"],
                         choices=["small", "medium", "large", "huge"])
     parser.add_argument("--custom", action="append", default=[],
-                        help="MESH,CONTACT,ORDER, e.g. 5,0.5,2")
+                        help="MESH,CONTACT,ORDER[,tet|hex], e.g. 5,0.5,2 or 5,0.5,1,hex")
     parser.add_argument("--sets", nargs="+", default=["mumps", "gamg", "hypre"],
                         help="option sets of LINEAR_SOLVERS (mumps, gamg, hypre, krylov)")
     parser.add_argument("--steps", type=int, default=2,
@@ -185,13 +185,18 @@ def main(sizes=("small",), custom=(), sets=("mumps", "gamg", "hypre"), steps=2, 
          near_nullspace="global", quiet=False, comm=MPI.COMM_WORLD):
     PETSc.Log.begin()  # needed for the KSPSolve / PCSetUp event times
     configs = [(name, *SIZES[name]) for name in sizes]
+    configs = [c + ("tetrahedron",) for c in configs]
     for spec in custom:
-        ms, cs, order = spec.split(",")
-        configs.append((spec, float(ms), float(cs), int(order)))
+        fields = spec.split(",")
+        ms, cs, order = fields[:3]
+        cell = {"tet": "tetrahedron", "hex": "hexahedron"}[fields[3] if len(fields) > 3
+                                                           else "tet"]
+        configs.append((spec, float(ms), float(cs), int(order), cell))
     summaries = []
-    for name, ms, cs, order in configs:
+    for name, ms, cs, order, cell in configs:
         t0 = MPI.Wtime()
-        scene = punch.quarter_punch(comm, mesh_size=ms, contact_size=cs, order=order)
+        scene = punch.quarter_punch(comm, mesh_size=ms, contact_size=cs, order=order,
+                                    cell_type=cell)
         n = scene.V.dofmap.index_map.size_global * 3
         PETSc.Sys.Print(f"\nflat punch {name} (mesh {ms} mm, contact {cs} mm, P{order}): {n} DOFs, "
                         f"{comm.size} rank(s), {steps} increments to 1000 N; mesh "
