@@ -1,7 +1,7 @@
 """Cattaneo–Mindlin and Mindlin–Deresiewicz under mesh refinement (rough_contact.scenes.mindlin).
 
     OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bench_mindlin.py [--levels 0.05 0.025]
-        [--part stick|energy|all] [--amplitudes 0.5]
+        [--part stick|energy|all] [--amplitudes 0.5] [--ring 0.25 [--ring-band 0.8 1.05]]
 
 Rigid paraboloid R = 10 mm on a half block 8 x 4 x 4 mm, E = 200 GPa, nu = 0.49, mu = 0.3,
 Coulomb penalty 1e8 MPa/mm (normal and tangential), P2, bottom pushed up by 4 um (P ~ 294 N,
@@ -55,7 +55,7 @@ def stick(levels, kt=None, kt_scale=None):
                             f"{int(r['newton'].sum()):6d} {dt:6.0f}")
 
 
-def energy(levels, amplitudes, kt=None, kt_scale=None):
+def energy(levels, amplitudes, kt=None, kt_scale=None, ring_size=None, ring_band=(0.8, 1.05)):
     PETSc.Sys.Print(f"{'h':>6} {'DOFs':>7} {'ampl':>5} {'Q*/muP':>6} {'W FE':>10} {'loop':>10} "
                     f"{'W MD':>10} {'error':>7} {'Newton':>6} {'time s':>6}")
     G = E / (2 * (1 + NU))
@@ -63,7 +63,9 @@ def energy(levels, amplitudes, kt=None, kt_scale=None):
         for amp in amplitudes:
             t0 = time.perf_counter()
             r = mindlin.run(contact_size=h, order=2, nu=NU, mu=MU, slide=amp * gross_slide(),
-                            cycles=2, shear_steps=16, k_tangential=_kt(h, kt, kt_scale))
+                            cycles=2, shear_steps=16, k_tangential=_kt(h, kt, kt_scale),
+                            ring_size=None if ring_size is None else h * ring_size,
+                            ring_band=tuple(ring_band))
             t, s, Q, D = r["t"], r["slide"], r["Q"], r["dissipation"]
             end1 = int(np.argmin(np.abs(t - 2.0)))
             idx = np.arange(end1, t.size)
@@ -86,11 +88,17 @@ def main(argv=None):
     ap.add_argument("--kt-scale", type=float, default=None,
                     help="tangential penalty k_T = KT_SCALE * E / h at element size h "
                     "(overrides --k-tangential)")
+    ap.add_argument("--ring", type=float, default=None,
+                    help="energy: element size in the ring (--ring-band) as a fraction of the "
+                    "level's contact size (e.g. 0.25: four times finer at the contact edge)")
+    ap.add_argument("--ring-band", type=float, nargs=2, default=[0.8, 1.05],
+                    help="the ring's radii as fractions of Hertz's radius sqrt(R delta)")
     args = ap.parse_args(argv)
     if args.part in ("stick", "all"):
         stick(args.levels, args.k_tangential, args.kt_scale)
     if args.part in ("energy", "all"):
-        energy(args.levels, args.amplitudes, args.k_tangential, args.kt_scale)
+        energy(args.levels, args.amplitudes, args.k_tangential, args.kt_scale, args.ring,
+               args.ring_band)
 
 
 if __name__ == "__main__":

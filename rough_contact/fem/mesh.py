@@ -896,7 +896,8 @@ def generate(model, order: int) -> None:
 
 
 def refine_towards(model, distance: str, contact_size: float, mesh_size: float,
-                   transition: float, regions: typing.Optional[typing.Sequence] = None) -> None:
+                   transition: float, regions: typing.Optional[typing.Sequence] = None,
+                   extra: typing.Sequence = ()) -> None:
     """Element size from ``contact_size`` at distance 0 to ``mesh_size`` beyond ``transition``.
 
     Args:
@@ -906,24 +907,33 @@ def refine_towards(model, distance: str, contact_size: float, mesh_size: float,
         regions: optional ``[(volume tags, contact size), ...]``: a size field per group of
             volumes (restricted to them, their faces and curves), the smallest size winning —
             bodies meshed separately with their own sizes at the contact.
+        extra: further ``[(distance, size, transition), ...]``: element size ``size`` at
+            distance 0 from another region (e.g. a ring around a contact edge), growing to
+            ``mesh_size`` over ``transition``; the smallest size wins everywhere.
     """
     import gmsh
 
     field = model.mesh.field
 
-    def threshold(size):
+    def threshold(size, dist_expr=distance, width=transition):
         dist = field.add("MathEval")
-        field.setString(dist, "F", distance)
+        field.setString(dist, "F", dist_expr)
         thr = field.add("Threshold")
         field.setNumber(thr, "InField", dist)
         field.setNumber(thr, "SizeMin", size)
         field.setNumber(thr, "SizeMax", mesh_size)
         field.setNumber(thr, "DistMin", 0.0)
-        field.setNumber(thr, "DistMax", transition)
+        field.setNumber(thr, "DistMax", width)
         return thr
 
+    more = [threshold(size, expr, width) for expr, size, width in extra]
     if regions is None:
-        field.setAsBackgroundMesh(threshold(contact_size))
+        main = threshold(contact_size)
+        if more:
+            smallest = field.add("Min")
+            field.setNumbers(smallest, "FieldsList", [main] + more)
+            main = smallest
+        field.setAsBackgroundMesh(main)
     else:
         restricted = []
         for vols, size in regions:
@@ -936,7 +946,7 @@ def refine_towards(model, distance: str, contact_size: float, mesh_size: float,
             field.setNumbers(res, "CurvesList", sorted({abs(t) for _, t in curves}))
             restricted.append(res)
         smallest = field.add("Min")
-        field.setNumbers(smallest, "FieldsList", restricted)
+        field.setNumbers(smallest, "FieldsList", restricted + more)
         field.setAsBackgroundMesh(smallest)
     gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
     gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)

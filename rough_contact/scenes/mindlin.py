@@ -145,7 +145,8 @@ def _program(preload_steps: int, shear_steps: int, cycles: int) -> LoadProgram:
 def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5, nu=0.49,
         mu=0.3, penalty=1e8, half_width=4.0, height=4.0, mesh_size=1.0, preload_steps=2,
         shear_steps=12, cycles=0, indenter="paraboloid", quadrature_degree=None,
-        k_tangential=None, comm=MPI.COMM_WORLD, verbose=False) -> dict:
+        k_tangential=None, ring_size=None, ring_band=(0.8, 1.05), comm=MPI.COMM_WORLD,
+        verbose=False) -> dict:
     """Normal indentation by ``delta`` [mm], then a tangential bottom displacement: monotonic to
     ``slide`` [mm] (``cycles`` = 0) or ``cycles`` triangle cycles of amplitude ``slide``.
 
@@ -160,6 +161,11 @@ def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5
     slip under the normal load alone (c/a 3 % small at every level); too soft (1e7 at a/8)
     adds its compliance and delays slip (c/a up to 4 % large). docs/mindlin.md has the study.
     ``quadrature_degree``: of the facet rule (default 2 ``order``).
+
+    ``ring_size``: element size [mm] in the annulus ``ring_band`` (fractions of Hertz's radius
+    sqrt(R delta)) where the slip zone of a small tangential load lies (c/a = 0.95 at
+    Q/mu P = 0.15, a ring 0.05 a wide); default: no ring, ``contact_size`` everywhere in the
+    contact. The tangential penalty keeps its ``contact_size`` scaling.
 
     ``slide`` defaults to the approach at which Mindlin's Q reaches mu P for Hertz's P at
     ``delta`` plus the block's shear compliance (so the last increments slide).
@@ -182,9 +188,17 @@ def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5
         slide = 3.0 * mu * P_h * (2.0 - nu) / (16.0 * G * a_h) + \
             mu * P_h * height / (G * 2.0 * half_width * half_width)
     check_scalar("slide", slide, lo=0.0, unit="mm")
+    ring = None
+    if ring_size is not None:
+        lo, hi = ring_band
+        if not 0.0 <= lo < hi:
+            raise ValueError(f"ring_band = {ring_band!r} is invalid: 0 <= lo < hi (fractions "
+                             "of Hertz's contact radius)")
+        a_h = np.sqrt(radius * delta)
+        ring = (0.5 * (lo + hi) * a_h, 0.5 * (hi - lo) * a_h, ring_size)
     scene = indented_block(half_width=half_width, height=height, mesh_size=mesh_size,
                            contact_size=contact_size, transition=1.0, order=order, half=True,
-                           comm=comm)
+                           ring=ring, comm=comm)
     V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", order))
     sym = fem.dirichletbc(PETSc.ScalarType(0.0), fem.locate_dofs_topological(
         V.sub(1), 2, scene.facet_tags.find(scene.tag("symmetry_y"))), V.sub(1))

@@ -348,3 +348,30 @@ def test_punch_builder_sweep(mesh_size, contact_size, order, cell_type):
     assert _global_node_count(scene) == _used_nodes_global(scene)
     assert np.isclose(measure_of(scene, "contact_punch"), 100.0, rtol=1e-10)
     assert check_conformity(scene).conforming
+
+
+def test_indented_block_ring_refines_the_band_only():
+    """``ring=(radius, half_band, size)``: top facets inside the band have edges near ``size``,
+    those well inside it keep the contact size (the distance field is exact)."""
+    from rough_contact.scenes.meshes.blocks import indented_block
+
+    h, ring = 0.1, (0.5, 0.1, 0.025)
+    scene = indented_block(half_width=2.0, height=1.5, mesh_size=0.6, contact_size=h,
+                           transition=0.5, refined_radius=1.0, half=True, ring=ring)
+    xyz = facet_vertex_coordinates(scene, scene.tag("contact"))
+    rho = np.linalg.norm(xyz.mean(axis=1)[:, :2], axis=1)
+    edge = np.linalg.norm(xyz - np.roll(xyz, 1, axis=1), axis=2).max(axis=1)
+
+    def count(sel):
+        return COMM.allreduce(int(sel.sum()), op=MPI.SUM)
+
+    def mean(sel):
+        return COMM.allreduce(float(edge[sel].sum()), op=MPI.SUM) / count(sel)
+
+    band = np.abs(rho - ring[0]) < 0.8 * ring[1]
+    inner = rho < 0.15
+    assert count(band) > 100 and count(inner) > 5
+    assert mean(band) < 1.3 * ring[2]
+    assert mean(inner) > 0.7 * h
+    with pytest.raises(ValueError, match="ring_size"):
+        indented_block(ring=(0.5, 0.1, 0.0))

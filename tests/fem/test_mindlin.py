@@ -16,6 +16,7 @@ not scaled, the same level is 6-9 % small: the edge points slip under the normal
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from rough_contact.scenes import mindlin
 
@@ -34,3 +35,8 @@ def test_cattaneo_mindlin_coarse():
     assert partial.sum() >= 3
     ref = mindlin.stick_ratio(Q[partial], r["mu"], P[partial])
     assert np.all(np.abs(stick[partial] / ref - 1.0) < 0.03)
+
+
+def test_ring_band_is_validated():
+    with pytest.raises(ValueError, match="ring_band"):
+        mindlin.run(ring_size=0.01, ring_band=(1.05, 0.8))

@@ -33,6 +33,8 @@ Labels: "block" (1), "contact" (11, z = 0), "top" (13), "x0".."y1" (15-18).
 
 from __future__ import annotations
 
+import typing
+
 import numpy as np
 from mpi4py import MPI
 
@@ -432,11 +434,15 @@ def block_on_plane(lx: float = 1.0, ly: float = 1.0, h: float = 1.0,
 def indented_block(half_width: float = 4.0, height: float = 4.0, mesh_size: float = 1.0,
                    contact_size: float = 0.05, transition: float = 1.0,
                    refined_radius: float = 0.4, order: int = 1, half: bool = False,
+                   ring: typing.Optional[tuple[float, float, float]] = None,
                    comm: MPI.Comm = MPI.COMM_WORLD) -> Scene:
     """Quarter of a block [0, L] x [0, L] x [-H, 0] for an indenter touching its top at the
     origin (or, with ``half``, the half [-L, L] x [0, L] x [-H, 0], for loads along x):
     element size ``contact_size`` within ``refined_radius`` of the origin, growing to
-    ``mesh_size`` over a further ``transition`` [mm]. Collective.
+    ``mesh_size`` over a further ``transition`` [mm]. ``ring = (radius, half_band, size)``
+    refines further around a contact edge: element size ``size`` within ``half_band`` of the
+    circle of ``radius`` about the z axis on the top face (the band's distance is measured in r
+    and depth), growing to the surrounding sizes over 2 ``half_band``. Collective.
 
     Labels: "block" (1); "contact" (11): top z = 0; "bottom" (14): z = -H;
     "symmetry_x" (17): x = 0 (empty for ``half``); "symmetry_y" (18): y = 0.
@@ -447,6 +453,10 @@ def indented_block(half_width: float = 4.0, height: float = 4.0, mesh_size: floa
                       contact_size=contact_size, transition=transition,
                       refined_radius=refined_radius)
     validate_order(order)
+    if ring is not None:
+        ring_radius, half_band, ring_size = ring
+        validate_positive(ring_radius=ring_radius, ring_half_band=half_band,
+                          ring_size=ring_size)
     tol = 1e-6 * max(half_width, height)
 
     def build(model):
@@ -463,8 +473,14 @@ def indented_block(half_width: float = 4.0, height: float = 4.0, mesh_size: floa
             del groups["symmetry_x"]
         add_groups(model, 2, groups)
         r = "Sqrt(x^2+y^2+z^2)"
+        extra = ()
+        if ring is not None:
+            # distance to the band |rho - R| <= b of the top face: (rho - R, z) outside the band
+            d_rho = f"Abs(Sqrt(x^2+y^2)-{ring_radius})-{half_band}"
+            d_band = f"Sqrt((({d_rho})+Abs({d_rho}))^2/4+z^2)"
+            extra = ((d_band, ring_size, 2.0 * half_band),)
         refine_towards(model, f"(Abs({r}-{refined_radius})+{r}-{refined_radius})/2",
-                       contact_size, mesh_size, transition)
+                       contact_size, mesh_size, transition, extra=extra)
         generate(model, order)
 
     return build_scene(
