@@ -356,6 +356,7 @@ class ContactInterface:
         self._communication(bcs)
         self.history = self._initial_history()
         self._last_u = self._last = self._last_jump = None
+        self._newton_memo = None   # a law's newton_tangent memo within one Newton solve
         self._cache_valid = False
         self._result_checked = False  # the first evaluation's result is checked in full
 
@@ -1062,7 +1063,12 @@ class ContactInterface:
         A.assemblyEnd(PETSc.Mat.AssemblyType.FLUSH)
         if self.n_groups == 0:  # setValuesRCV with zero rows dies with SIGFPE
             return
-        D = self._to_slots(res.tangent * self._weights[:, None, None])
+        tangent = res.tangent
+        newton_tangent = getattr(self.law, "newton_tangent", None)
+        if newton_tangent is not None:   # a law's Newton-step tangent (residual unchanged)
+            tangent, self._newton_memo = newton_tangent(
+                self._last_jump, self.history.committed, res, self._newton_memo)
+        D = self._to_slots(tangent * self._weights[:, None, None])
         DB = D @ self._B  # (n_g * nqs, 3, nd)
         K = self._BfT @ DB.reshape(self._Bf.shape)  # (n_g, nd, nd), batched BLAS
         rows = self._rows
@@ -1079,12 +1085,20 @@ class ContactInterface:
             self.evaluate(u)
         self.history.commit()
         self._cache_valid = False  # a new committed state: never reuse the old evaluation
+        self._newton_memo = None
 
     def revert(self) -> None:
         """Discard the trial state (failed increment, before a cutback)."""
         self.history.revert()
         self._last = None
         self._cache_valid = False
+        self._newton_memo = None
+
+    def begin_solve(self) -> None:
+        """Forget what the previous Newton solve's Jacobians remembered (a law's
+        ``newton_tangent`` memo, e.g. the slip directions of ``SoftplusPenalty``); the SNES
+        wrapper calls it before every solve."""
+        self._newton_memo = None
 
     # ------------------------------------------------------------------ output
     def _result(self) -> LawResult:

@@ -12,6 +12,7 @@ Units: mm, N, MPa. Jumps [mm]; tractions [MPa]; stiffnesses per area [MPa/mm].
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Optional
 
 import numpy as np
 from scipy.special import expit
@@ -94,23 +95,41 @@ class SoftplusPenalty:
     The tangent is the consistent (non-symmetric) one. ``area_fraction`` = sigmoid(-g / w)
     is a toy measure (0 far open, 1 deep in contact).
 
+    Newton steps (:meth:`newton_tangent`, used by the FE interface for the Jacobian only): the
+    consistent tangent of a slipping point, k_T mu p / |tau| (I - m m^T), has no stiffness
+    along the slip direction m, so a Newton step can drive the trial traction tau through zero
+    and reverse the slip direction of a point (seen on the unloading branch of the flat punch:
+    ~100 of 1 500 points per iteration, the backtracking line search then cuts the steps to
+    15-25 %). A point that is slipping and whose trial direction reversed (m . m_prev < 0)
+    since the previous Jacobian of the same Newton solve gets the secant stiffness
+    ``reversal_stiffness`` x k_T mu p / |tau| along m in that Jacobian. The residual is
+    unchanged, so is the converged solution; points that stopped reversing get the consistent
+    tangent back, so the final iterations stay quadratic (docs/coulomb.md: 173 -> 146 Newton
+    iterations at level 1, 237 -> 202 at level 3). ``reversal_stiffness = 0`` gives the
+    consistent tangent everywhere.
+
     Args:
         k_normal: normal stiffness k_N > 0 [MPa/mm].
         width: smoothing length w > 0 [mm].
         k_tangential: tangential stiffness k_T >= 0 [MPa/mm].
         friction: Coulomb coefficient mu >= 0 [-] (needs k_T > 0 to matter).
+        reversal_stiffness: factor >= 0 [-] of the secant stiffness added along m at points
+            whose slip direction reversed between two Jacobians (Newton steps only, see
+            above; 0 = off).
     """
 
     k_normal: float
     width: float
     k_tangential: float = 0.0
     friction: float = 0.0
+    reversal_stiffness: float = 1.0
 
     def __post_init__(self) -> None:
         check_scalar("k_normal", self.k_normal, lo=0.0, unit="MPa/mm")
         check_scalar("width", self.width, lo=0.0, unit="mm")
         check_scalar("k_tangential", self.k_tangential, lo=0.0, lo_open=False, unit="MPa/mm")
         check_scalar("friction", self.friction, lo=0.0, lo_open=False)
+        check_scalar("reversal_stiffness", self.reversal_stiffness, lo=0.0, lo_open=False)
 
     def initial_state(self, n_pts: int) -> InterfaceState:
         """Virgin history (no plastic slip) at n_pts points."""
@@ -181,3 +200,37 @@ class SoftplusPenalty:
             contact=p > 0.0,
             slipping=slipping,
         )
+
+    def newton_tangent(self, jump: np.ndarray, committed: InterfaceState, result: LawResult,
+                       previous: Optional[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+        """Tangent for a Newton step at ``jump`` (pure; the residual is not affected).
+
+        Args:
+            jump: (n, 3) jump the law was evaluated at [mm].
+            committed: the committed history ``result`` was computed from.
+            result: ``evaluate(jump, committed)``.
+            previous: what the previous call of the same Newton solve returned as its second
+                value (None at the first Jacobian of a solve).
+
+        Returns:
+            (tangent (n, 3, 3), memo): the tangent is ``result.tangent`` with the secant
+            stiffness ``reversal_stiffness`` k_T |t_T| / |tau| added along m = tau / |tau| at
+            slipping points whose trial direction reversed since ``previous`` (see the
+            class); memo = (n, 2) trial directions m, to pass as ``previous`` next time.
+        """
+        if self.k_tangential <= 0.0:
+            return result.tangent, None
+        tau = self.k_tangential * (jump[:, 1:] - committed.plastic_slip)
+        norm = np.linalg.norm(tau, axis=1)
+        m = np.divide(tau, norm[:, None], out=np.zeros_like(tau), where=norm[:, None] > 0.0)
+        tangent = result.tangent
+        if (self.reversal_stiffness > 0.0 and previous is not None
+                and previous.shape == m.shape):
+            flip = result.slipping & (np.einsum("ij,ij->i", m, previous) < 0.0)
+            if np.any(flip):
+                tangent = tangent.copy()
+                mf = m[flip]
+                secant = (self.reversal_stiffness * self.k_tangential
+                          * np.linalg.norm(result.traction[flip, 1:], axis=1) / norm[flip])
+                tangent[flip, 1:, 1:] += secant[:, None, None] * mf[:, :, None] * mf[:, None, :]
+        return tangent, m

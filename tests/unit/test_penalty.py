@@ -130,3 +130,32 @@ def test_bad_input():
     # a non-finite jump is a diverging global iterate: a convergence failure (cutback)
     with pytest.raises(ConvergenceError, match=r"not finite at 1 of 2 points \(first index 1\)"):
         law.evaluate(np.array([[0.0, 0, 0], [np.nan, 0, 0]]), law.initial_state(2))
+
+
+def test_softplus_newton_tangent_reversal():
+    """newton_tangent adds the secant stiffness along m only at slipping points whose trial
+    direction reversed since the previous Jacobian; traction and history are the law's."""
+    law = SoftplusPenalty(k_normal=1e4, width=1e-4, k_tangential=1e4, friction=0.3)
+    committed = law.initial_state(4)
+    # points 0, 1 slipping (+x, -x), point 2 slipping along +y, point 3 sticking (tiny slip)
+    jump = np.array([[-1e-2, 5e-3, 0.0], [-1e-2, -5e-3, 0.0], [-1e-2, 0.0, 5e-3],
+                     [-1e-2, 1e-8, 0.0]])
+    res = law.evaluate(jump, committed)
+    assert res.slipping.tolist() == [True, True, True, False]
+    t0, memo = law.newton_tangent(jump, committed, res, None)
+    assert t0 is res.tangent                                 # first Jacobian: consistent
+    np.testing.assert_allclose(memo, [[1, 0], [-1, 0], [0, 1], [1, 0]])
+    previous = np.array([[-1.0, 0.0], [-1.0, 0.0], [0.0, 1.0], [-1.0, 0.0]])
+    t1, _ = law.newton_tangent(jump, committed, res, previous)
+    p, _ = law.normal(jump[:, 0])
+    secant = law.k_tangential * law.friction * p[0] / (law.k_tangential * 5e-3)
+    expected = res.tangent.copy()
+    expected[0, 1, 1] += secant                              # reversed and slipping: +x x +x
+    np.testing.assert_allclose(t1, expected, rtol=1e-12, atol=0)
+    assert np.array_equal(res.tangent, law.evaluate(jump, committed).tangent)   # pure
+    off = SoftplusPenalty(k_normal=1e4, width=1e-4, k_tangential=1e4, friction=0.3,
+                          reversal_stiffness=0.0)
+    t2, _ = off.newton_tangent(jump, committed, off.evaluate(jump, committed), previous)
+    np.testing.assert_array_equal(t2, res.tangent)
+    with pytest.raises(ValueError, match="reversal_stiffness"):
+        SoftplusPenalty(k_normal=1e4, width=1e-4, reversal_stiffness=-1.0)
