@@ -12,7 +12,8 @@ increment, CPU time and the dissipation at the peak and at the end.
         [--levels 1 2 3] [--mu 0.2 0.5] [--k 1e7] [--predictor none secant]
         [--reversal-stiffness 0 1] [--csv FILE]
 
-Level 1: P1, contact size 1.25 mm (~4.7 k DOFs); level 2: 0.6 mm (~28 k); level 3: 0.4 mm.
+Levels (P1; mesh and contact size in LEVELS): 1 ~4.5 k DOFs, 2 ~26 k, 3 ~73 k, 4 ~99 k (the size
+of GetFEM's finest run).
 Units: mm, N, MPa.
 """
 
@@ -35,7 +36,8 @@ from rough_contact.interface.penalty import SoftplusPenalty
 from rough_contact.scenes import flat_punch
 from rough_contact.solver.loading import load_path, load_unload_factors
 
-LEVELS = {1: (10.0, 0.7), 2: (5.0, 0.3), 3: (3.3, 0.2)}   # (mesh size, contact size) [mm]
+# (mesh size, contact size) [mm]
+LEVELS = {1: (10.0, 0.7), 2: (5.0, 0.3), 3: (3.3, 0.2), 4: (3.3, 0.165)}
 N_LOAD = 16
 
 

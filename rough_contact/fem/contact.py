@@ -63,6 +63,7 @@ from rough_contact.fem.rigid import RigidSurface
 from rough_contact.interface.contract import (
     ConvergenceError,
     InterfaceLawProtocol,
+    NewtonTangentLaw,
     LawContractError,
     LawResult,
     LawState,
@@ -1064,9 +1065,8 @@ class ContactInterface:
         if self.n_groups == 0:  # setValuesRCV with zero rows dies with SIGFPE
             return
         tangent = res.tangent
-        newton_tangent = getattr(self.law, "newton_tangent", None)
-        if newton_tangent is not None:   # a law's Newton-step tangent (residual unchanged)
-            tangent, self._newton_memo = newton_tangent(
+        if isinstance(self.law, NewtonTangentLaw):   # Newton-step tangent (residual unchanged)
+            tangent, self._newton_memo = self.law.newton_tangent(
                 self._last_jump, self.history.committed, res, self._newton_memo)
         D = self._to_slots(tangent * self._weights[:, None, None])
         DB = D @ self._B  # (n_g * nqs, 3, nd)

@@ -71,7 +71,7 @@ from typing import Optional, Protocol, TypeVar, runtime_checkable
 import numpy as np
 
 __all__ = ["ConvergenceError", "LawState", "LawResult", "InterfaceLawProtocol",
-           "LawContractError", "check_jump"]
+           "FrictionBoundedLaw", "NewtonTangentLaw", "LawContractError", "check_jump"]
 
 
 class ConvergenceError(ArithmeticError):
@@ -200,6 +200,21 @@ class FrictionBoundedLaw(Protocol):
     def max_friction_coefficient(self) -> float:
         """The largest friction coefficient the law can reach (saturated, over all directions);
         0 for a frictionless law."""
+        ...
+
+
+@runtime_checkable
+class NewtonTangentLaw(Protocol):
+    """A law that proposes, for the Newton step only, a tangent other than the consistent one
+    (the residual and so the converged solution are unchanged). The FE interface calls it at
+    every Jacobian assembly with what the previous call of the same Newton solve returned
+    (``None`` at the first Jacobian of a solve: the interface forgets it at every new solve,
+    commit and revert)."""
+
+    def newton_tangent(self, jump: np.ndarray, committed: LawState, result: LawResult,
+                       previous: Optional[np.ndarray]
+                       ) -> tuple[np.ndarray, Optional[np.ndarray]]:
+        """(tangent (n, 3, 3) for the Newton step at ``jump``, memo for the next call)."""
         ...
 
 

@@ -287,9 +287,8 @@ class SNESSolver:
             self.snes.setJacobian(self.problem.J, self.problem.A)
             self._A = self.problem.A
         self.problem.u.vector.copy(self.x)
-        begin = getattr(self.problem.interface, "begin_solve", None)
-        if begin is not None:
-            begin()   # a new solve: no Newton-step memory from the previous one
+        if self.problem.interface is not None:
+            self.problem.interface.begin_solve()   # no Newton-step memory from the last solve
         if self._auto_atol:
             # Round-off floor of F = K u - f: about eps |K|_inf |u|_inf. Below it Newton cannot
             # converge (seen at a total load of 1 mN on the punch, tests/fem/test_extremes.py).

@@ -262,3 +262,19 @@ def test_friction_bounded_laws(gw_normal):
     assert all(isinstance(laws[k], FrictionBoundedLaw) for k in
                ("rough_ortho", "rough_iso", "rough_frictionless", "softplus_penalty"))
     assert not isinstance(laws["linear_penalty"], FrictionBoundedLaw)   # unbounded spring
+
+
+def test_newton_tangent_laws(gw_normal):
+    """Only the Coulomb penalty declares a Newton-step tangent; it returns the consistent
+    tangent at the first Jacobian of a solve (no memo yet) and the memo has one row per point."""
+    from rough_contact.interface.contract import NewtonTangentLaw
+
+    laws = built_in_laws(gw_normal)
+    assert [k for k, law in laws.items() if isinstance(law, NewtonTangentLaw)] == \
+        ["softplus_penalty"]
+    law = laws["softplus_penalty"]
+    jump = np.array([[-1e-3, 2e-3, 0.0], [-1e-3, 0.0, -5e-3]])
+    res = law.evaluate(jump, law.initial_state(2))
+    tangent, memo = law.newton_tangent(jump, law.initial_state(2), res, None)
+    np.testing.assert_array_equal(tangent, res.tangent)
+    assert memo.shape == (2, 2)
