@@ -84,7 +84,8 @@ def main(argv=None):
     ap.add_argument("--verbose", action="store_true")
     args, _petsc = ap.parse_known_args(argv)   # the rest goes to PETSc
     rows = []
-    head = (f"{'level':>5} {'DOFs':>7} {'points':>6} {'mu':>4} {'k':>7} {'rev':>4} {'predictor':>9} "
+    head = (f"{'level':>5} {'DOFs':>7} {'points':>6} {'mu':>4} {'k':>7} {'rev':>4} "
+            f"{'predictor':>9} "
             f"{'Newton':>6} {'solves':>6} {'cutb':>4} {'max/inc':>7} {'CPU s':>7} "
             f"{'D peak':>10} {'D end':>10} {'slip':>5}")
     PETSc.Sys.Print(head)
@@ -99,8 +100,9 @@ def main(argv=None):
                             reversal_stiffness=rs)
                     rows.append(r)
                     PETSc.Sys.Print(
-                        f"{r['level']:5d} {r['dofs']:7d} {r['points']:6d} {mu:4.2f} {k:7.1e} {rs:4.2g} "
-                        f"{pred + '/' + quad[0]:>9} {r['newton']:6d} {r['solves']:6d} {r['cutbacks']:4d} "
+                        f"{r['level']:5d} {r['dofs']:7d} {r['points']:6d} {mu:4.2f} {k:7.1e} "
+                        f"{rs:4.2g} {pred + '/' + quad[0]:>9} {r['newton']:6d} "
+                        f"{r['solves']:6d} {r['cutbacks']:4d} "
                         f"{r['max_its']:7d} {r['cpu']:7.1f} {r['D_peak']:10.4e} "
                         f"{r['D_end']:10.4e} {r['slip_peak']:5.2f}")
     if args.csv and MPI.COMM_WORLD.rank == 0:

@@ -32,8 +32,8 @@ Sizes (quarter punch, tetrahedra, P2 unless noted):
     medium  P2, mesh 5 mm, contact 0.5 mm       (~88 k DOFs)
     large   P2, mesh 3.5 mm, contact 0.35 mm    (~228 k DOFs)
     huge    P2, mesh 2.1 mm, contact 0.21 mm    (~1 M DOFs; see docs/solver.md for memory)
-Custom: --custom MESH,CONTACT,ORDER[,tet|hex] (repeatable; hex: hexahedra, Q1/Q2). Options -rc_* apply to every run (they are
-copied to each run's own prefix). Units: mm, N, MPa.
+Custom: --custom MESH,CONTACT,ORDER[,tet|hex] (repeatable; hex: hexahedra, Q1/Q2). Options
+-rc_* apply to every run (they are copied to each run's own prefix). Units: mm, N, MPa.
 """
 
 from __future__ import annotations
@@ -198,7 +198,9 @@ def main(sizes=("small",), custom=(), sets=("mumps", "gamg", "hypre"), steps=2, 
         scene = punch.quarter_punch(comm, mesh_size=ms, contact_size=cs, order=order,
                                     cell_type=cell)
         n = scene.V.dofmap.index_map.size_global * 3
-        PETSc.Sys.Print(f"\nflat punch {name} (mesh {ms} mm, contact {cs} mm, P{order}): {n} DOFs, "
+        element = ("Q" if cell == "hexahedron" else "P") + str(order)
+        PETSc.Sys.Print(f"\nflat punch {name} (mesh {ms} mm, contact {cs} mm, {element}): "
+                        f"{n} DOFs, "
                         f"{comm.size} rank(s), {steps} increments to 1000 N; mesh "
                         f"{MPI.Wtime() - t0:.1f} s; times per Newton iteration [s] (max over "
                         "ranks), memory summed over ranks [MB]", comm=comm)
