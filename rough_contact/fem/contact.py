@@ -63,10 +63,10 @@ from rough_contact.fem.rigid import RigidSurface
 from rough_contact.interface.contract import (
     ConvergenceError,
     InterfaceLawProtocol,
-    NewtonTangentLaw,
     LawContractError,
     LawResult,
     LawState,
+    NewtonTangentLaw,
 )
 from rough_contact.interface.state import StatePair
 from rough_contact.validation import check_scalar

@@ -14,6 +14,7 @@ from rough_contact.scenes import flat_punch
 from rough_contact.solver.loading import load_path, load_unload_factors
 
 N_LOAD = 8
+MESH = (10.0, 1.2)   # (mesh size, contact size) [mm]
 
 
 def _run(reversal_stiffness):
@@ -31,8 +32,6 @@ def _run(reversal_stiffness):
     m.solver.destroy()
     return incs, u
 
-
-MESH = (10.0, 1.2)
 
 
 def test_reversal_stiffness_same_path_fewer_iterations():
