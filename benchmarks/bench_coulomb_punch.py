@@ -10,7 +10,7 @@ increment, CPU time and the dissipation at the peak and at the end.
 
     OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bench_coulomb_punch.py \\
         [--levels 1 2 3] [--mu 0.2 0.5] [--k 1e7] [--predictor none secant]
-        [--reversal-stiffness 0 1] [--csv FILE]
+        [--reversal-stiffness 0 1] [--augmented 0 1] [--al-tol 1e-3] [--csv FILE]
 
 Levels (P1; mesh and contact size in LEVELS): 1 ~4.5 k DOFs, 2 ~26 k, 3 ~73 k, 4 ~99 k (the size
 of GetFEM's finest run).
@@ -42,10 +42,12 @@ N_LOAD = 16
 
 
 def run(level: int, mu: float, k: float, width: float, predictor: str, quadrature="gauss",
-        comm=MPI.COMM_WORLD, verbose=False, reversal_stiffness=1.0) -> dict:
+        comm=MPI.COMM_WORLD, verbose=False, reversal_stiffness=1.0, augmented=False,
+        al_tol=1e-3) -> dict:
     mesh_size, contact_size = LEVELS[level]
     law = SoftplusPenalty(k_normal=k, width=width, k_tangential=k, friction=mu,
-                          reversal_stiffness=reversal_stiffness)
+                          reversal_stiffness=reversal_stiffness, augmented=augmented,
+                          augmentation_tolerance=al_tol)
     m = flat_punch.build(comm, mesh_size=mesh_size, contact_size=contact_size, order=1,
                          load_half_width=10.0, law=law, steps=N_LOAD, quadrature=quadrature)
     factors = load_unload_factors(N_LOAD, N_LOAD - 1, final_factor=1.0 / N_LOAD)
@@ -58,7 +60,8 @@ def run(level: int, mu: float, k: float, width: float, predictor: str, quadratur
     peak = next(i for i in incs if i.load_factor == 1.0)
     out = dict(level=level, dofs=m.problem.num_dofs, points=m.interface.n_points_global, mu=mu,
                k=k, predictor=predictor, quadrature=quadrature,
-               reversal_stiffness=reversal_stiffness,
+               reversal_stiffness=reversal_stiffness, augmented=augmented, al_tol=al_tol,
+               al_updates=sum(i.augmentations for i in incs),
                newton=sum(i.newton_total for i in incs),
                solves=len(incs) + sum(i.failed_attempts for i in incs),
                cutbacks=sum(i.cutbacks for i in incs),
@@ -80,28 +83,34 @@ def main(argv=None):
     ap.add_argument("--quadrature", nargs="+", default=["gauss"], choices=["gauss", "vertex"])
     ap.add_argument("--reversal-stiffness", type=float, nargs="+", default=[1.0],
                     help="SoftplusPenalty.reversal_stiffness (0 = consistent tangent everywhere)")
+    ap.add_argument("--augmented", type=int, nargs="+", default=[0], choices=[0, 1],
+                    help="1 = augmented Lagrangian (Uzawa) on top of the penalty")
+    ap.add_argument("--al-tol", type=float, default=1e-3,
+                    help="SoftplusPenalty.augmentation_tolerance")
     ap.add_argument("--csv", default=None)
     ap.add_argument("--verbose", action="store_true")
     args, _petsc = ap.parse_known_args(argv)   # the rest goes to PETSc
     rows = []
     head = (f"{'level':>5} {'DOFs':>7} {'points':>6} {'mu':>4} {'k':>7} {'rev':>4} "
-            f"{'predictor':>9} "
+            f"{'predictor':>9} {'AL':>2} {'upd':>4} "
             f"{'Newton':>6} {'solves':>6} {'cutb':>4} {'max/inc':>7} {'CPU s':>7} "
             f"{'D peak':>10} {'D end':>10} {'slip':>5}")
     PETSc.Sys.Print(head)
     for level in args.levels:
         for mu in args.mu:
             for k in args.k:
-                for pred, quad, rs in [(a, b, c) for a in args.predictor
-                                       for b in args.quadrature
-                                       for c in args.reversal_stiffness]:
+                for pred, quad, rs, al in [(a, b, c, d) for a in args.predictor
+                                           for b in args.quadrature
+                                           for c in args.reversal_stiffness
+                                           for d in args.augmented]:
                     w = args.width if args.width is not None else 1e-2 * 2.5 / k
                     r = run(level, mu, k, w, pred, quad, verbose=args.verbose,
-                            reversal_stiffness=rs)
+                            reversal_stiffness=rs, augmented=bool(al), al_tol=args.al_tol)
                     rows.append(r)
                     PETSc.Sys.Print(
                         f"{r['level']:5d} {r['dofs']:7d} {r['points']:6d} {mu:4.2f} {k:7.1e} "
-                        f"{rs:4.2g} {pred + '/' + quad[0]:>9} {r['newton']:6d} "
+                        f"{rs:4.2g} {pred + '/' + quad[0]:>9} {al:2d} {r['al_updates']:4d} "
+                        f"{r['newton']:6d} "
                         f"{r['solves']:6d} {r['cutbacks']:4d} "
                         f"{r['max_its']:7d} {r['cpu']:7.1f} {r['D_peak']:10.4e} "
                         f"{r['D_end']:10.4e} {r['slip_peak']:5.2f}")

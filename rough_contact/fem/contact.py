@@ -61,6 +61,8 @@ from rough_contact.fem.pairing import (SecondSurface, _newton_on_facets, cyclic_
 from rough_contact.fem.rigid import RigidPlane as RigidPlaneSurface
 from rough_contact.fem.rigid import RigidSurface
 from rough_contact.interface.contract import (
+    AugmentationControl,
+    AugmentedLagrangianLaw,
     ConvergenceError,
     InterfaceLawProtocol,
     LawContractError,
@@ -358,6 +360,7 @@ class ContactInterface:
         self.history = self._initial_history()
         self._last_u = self._last = self._last_jump = None
         self._newton_memo = None   # a law's newton_tangent memo within one Newton solve
+        self._augment_base = None  # committed state before this increment's multiplier updates
         self._cache_valid = False
         self._result_checked = False  # the first evaluation's result is checked in full
 
@@ -1086,13 +1089,61 @@ class ContactInterface:
         self.history.commit()
         self._cache_valid = False  # a new committed state: never reuse the old evaluation
         self._newton_memo = None
+        self._augment_base = None
 
     def revert(self) -> None:
-        """Discard the trial state (failed increment, before a cutback)."""
+        """Discard the trial state (failed increment, before a cutback), and the multiplier
+        updates of the increment if the law is an augmented-Lagrangian one."""
+        if self._augment_base is not None:
+            self.history.restore(self._augment_base, self.history.dissipated)
+            self._augment_base = None
         self.history.revert()
         self._last = None
         self._cache_valid = False
         self._newton_memo = None
+
+    def augmentation(self) -> Optional[AugmentationControl]:
+        """The law's augmented-Lagrangian control (None for a plain law: no multiplier loop)."""
+        if isinstance(self.law, AugmentedLagrangianLaw):
+            return self.law.augmentation()
+        return None
+
+    def augment(self, tolerance: float) -> tuple[float, bool]:
+        """One Uzawa update of the multipliers from the last evaluation (collective).
+
+        The relative change is the largest multiplier change over all points and ranks divided
+        by the largest traction magnitude |t| (0 if no point carries any). If it exceeds
+        ``tolerance`` the committed state takes the new multipliers (the trial state is
+        dropped; the next Newton solve uses them); otherwise nothing changes and the trial state
+        can be committed. :meth:`revert` undoes the updates of the current increment.
+
+        Returns:
+            (relative change, whether the multipliers were updated).
+
+        Raises:
+            ValueError: the law has no augmented-Lagrangian control, or the interface was not
+                evaluated since the last commit/revert.
+        """
+        if self.augmentation() is None:
+            raise ValueError(f"the law {type(self.law).__name__} is not an augmented-Lagrangian "
+                             "law (AugmentedLagrangianLaw with augmentation() not None)")
+        res = self._result()
+        new, change = self.law.augment(self.history.committed, res)
+        top = np.zeros(2)
+        if change.size:
+            top[:] = change.max(), np.linalg.norm(res.traction, axis=1).max()
+        self.comm.Allreduce(MPI.IN_PLACE, top, op=MPI.MAX)
+        top_change, top_traction = top
+        rel = top_change / top_traction if top_traction > 0.0 else 0.0
+        if rel <= tolerance:
+            return rel, False
+        if self._augment_base is None:
+            self._augment_base = self.history.committed
+        self.history.restore(new, self.history.dissipated)
+        self._last = None
+        self._cache_valid = False
+        self._newton_memo = None
+        return rel, True
 
     def begin_solve(self) -> None:
         """Forget what the previous Newton solve's Jacobians remembered (a law's

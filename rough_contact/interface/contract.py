@@ -71,7 +71,8 @@ from typing import Optional, Protocol, TypeVar, runtime_checkable
 import numpy as np
 
 __all__ = ["ConvergenceError", "LawState", "LawResult", "InterfaceLawProtocol",
-           "FrictionBoundedLaw", "NewtonTangentLaw", "LawContractError", "check_jump"]
+           "FrictionBoundedLaw", "NewtonTangentLaw", "AugmentationControl",
+           "AugmentedLagrangianLaw", "LawContractError", "check_jump"]
 
 
 class ConvergenceError(ArithmeticError):
@@ -215,6 +216,45 @@ class NewtonTangentLaw(Protocol):
                        previous: Optional[np.ndarray]
                        ) -> tuple[np.ndarray, Optional[np.ndarray]]:
         """(tangent (n, 3, 3) for the Newton step at ``jump``, memo for the next call)."""
+        ...
+
+
+@dataclass(frozen=True)
+class AugmentationControl:
+    """How the load stepping iterates an augmented-Lagrangian law's multipliers (Uzawa).
+
+    Attributes:
+        tolerance: the multipliers are converged when the largest change of one update, over
+            all points and ranks, is at most ``tolerance`` times the largest traction
+            magnitude |t| of the interface [-].
+        max_updates: multiplier updates allowed per load increment; beyond them the increment
+            counts as not converged (the load stepping cuts back).
+    """
+
+    tolerance: float
+    max_updates: int
+
+
+@runtime_checkable
+class AugmentedLagrangianLaw(Protocol):
+    """A penalty law whose constraints are enforced exactly by multipliers updated between
+    Newton solves (Uzawa's augmented-Lagrangian iteration).
+
+    Within one Newton solve the multipliers are held in the committed state; after the solve
+    converged the load stepping (``rough_contact.solver.loading``) asks the interface for an
+    update, which calls :meth:`augment`; if the multipliers moved by more than the tolerance
+    of :meth:`augmentation` it solves again with the updated ones, else it commits. A failed
+    increment restores the multipliers the increment started from. The protocol is optional:
+    a law without it (or whose :meth:`augmentation` returns None) is a plain penalty law."""
+
+    def augmentation(self) -> Optional[AugmentationControl]:
+        """The iteration's control, or None when the law is used as a plain penalty."""
+        ...
+
+    def augment(self, committed: LawState, result: LawResult) -> tuple[LawState, np.ndarray]:
+        """(``committed`` with its multipliers replaced by those of ``result``, the (n,)
+        magnitude of each point's multiplier change [MPa]); pure, keeps every other history
+        variable of ``committed``."""
         ...
 
 

@@ -18,8 +18,8 @@ import numpy as np
 from scipy.special import expit
 
 from ..validation import check_scalar
-from .contract import LawResult, check_jump
-from .state import InterfaceState
+from .contract import AugmentationControl, LawResult, check_jump
+from .state import AugmentedState, InterfaceState
 
 __all__ = ["LinearPenalty", "SoftplusPenalty"]
 
@@ -116,6 +116,12 @@ class SoftplusPenalty:
         reversal_stiffness: factor >= 0 [-] of the secant stiffness added along m at points
             whose slip direction reversed between two Jacobians (Newton steps only, see
             above; 0 = off).
+        augmented: enforce the contact and stick constraints exactly by an augmented-
+            Lagrangian (Uzawa) iteration on the multipliers (see above); False = plain penalty.
+        augmentation_tolerance: convergence of the multipliers, relative to the largest traction
+            magnitude of the interface (0 < tol < 1) [-].
+        max_augmentations: multiplier updates per load increment (>= 1) before the increment
+            counts as not converged (cutback).
     """
 
     k_normal: float
@@ -123,6 +129,9 @@ class SoftplusPenalty:
     k_tangential: float = 0.0
     friction: float = 0.0
     reversal_stiffness: float = 1.0
+    augmented: bool = False
+    augmentation_tolerance: float = 1e-3
+    max_augmentations: int = 30
 
     def __post_init__(self) -> None:
         check_scalar("k_normal", self.k_normal, lo=0.0, unit="MPa/mm")
@@ -130,10 +139,53 @@ class SoftplusPenalty:
         check_scalar("k_tangential", self.k_tangential, lo=0.0, lo_open=False, unit="MPa/mm")
         check_scalar("friction", self.friction, lo=0.0, lo_open=False)
         check_scalar("reversal_stiffness", self.reversal_stiffness, lo=0.0, lo_open=False)
+        if not isinstance(self.augmented, bool):
+            raise ValueError(f"augmented = {self.augmented!r} is invalid: it must be True or False")
+        check_scalar("augmentation_tolerance", self.augmentation_tolerance, lo=0.0, hi=1.0,
+                     hi_open=True)
+        if (not isinstance(self.max_augmentations, (int, np.integer))
+                or isinstance(self.max_augmentations, bool) or self.max_augmentations < 1):
+            raise ValueError(f"max_augmentations = {self.max_augmentations!r} is invalid: it "
+                             "must be an integer >= 1")
 
     def initial_state(self, n_pts: int) -> InterfaceState:
-        """Virgin history (no plastic slip) at n_pts points."""
-        return InterfaceState.zeros(n_pts)
+        """Virgin history (no plastic slip; zero multipliers if augmented) at n_pts points."""
+        return AugmentedState.zeros(n_pts) if self.augmented else InterfaceState.zeros(n_pts)
+
+    def augmentation(self) -> Optional[AugmentationControl]:
+        """The Uzawa iteration's control if ``augmented``, else None
+        (``rough_contact.interface.contract.AugmentedLagrangianLaw``)."""
+        if not self.augmented:
+            return None
+        return AugmentationControl(float(self.augmentation_tolerance),
+                                   int(self.max_augmentations))
+
+    def augment(self, committed: InterfaceState, result: LawResult
+                ) -> tuple[InterfaceState, np.ndarray]:
+        """``committed`` with the multipliers of ``result`` (its tractions), and the (n,)
+        magnitude of the change [MPa]; pure. Plastic slip and hardening stay committed ones."""
+        if not (self.augmented and isinstance(committed, AugmentedState)
+                and isinstance(result.state, AugmentedState)):
+            raise ValueError("augment needs augmented=True and AugmentedState histories "
+                             f"(got augmented={self.augmented}, committed "
+                             f"{type(committed).__name__}, trial {type(result.state).__name__})")
+        new = committed.copy()
+        new.multiplier = result.state.multiplier.copy()
+        return new, np.linalg.norm(new.multiplier - committed.multiplier, axis=1)
+
+    def _shifts(self, committed: InterfaceState) -> tuple[np.ndarray, np.ndarray]:
+        """(gap shift lambda_N / k_N (n,) [mm] or 0, tangential multiplier (n, 2) [MPa] or 0)."""
+        if self.augmented:
+            if not isinstance(committed, AugmentedState):
+                raise ValueError("augmented=True needs the AugmentedState of initial_state, got "
+                                 f"{type(committed).__name__}")
+            return committed.multiplier[:, 0] / self.k_normal, committed.multiplier[:, 1:]
+        return np.zeros(len(committed)), np.zeros((len(committed), 2))
+
+    def _trial_traction(self, jump: np.ndarray, committed: InterfaceState,
+                        lam_t: np.ndarray) -> np.ndarray:
+        """Elastic predictor tau = lambda_T + k_T (s - s_p) (n, 2) [MPa]."""
+        return lam_t + self.k_tangential * (jump[:, 1:] - committed.plastic_slip)
 
     def max_friction_coefficient(self) -> float:
         """mu (0 without tangential stiffness): |t_T| <= mu p
@@ -156,7 +208,8 @@ class SoftplusPenalty:
         """
         jump = _check_inputs(jump, committed)
         n = jump.shape[0]
-        p, k = self.normal(jump[:, 0])
+        shift, lam_t = self._shifts(committed)
+        p, k = self.normal(jump[:, 0] - shift)
         traction = np.zeros((n, 3))
         tangent = np.zeros((n, 3, 3))
         traction[:, 0] = -p
@@ -166,7 +219,7 @@ class SoftplusPenalty:
         slipping = np.zeros(n, dtype=bool)
         if self.k_tangential > 0.0:
             kt = self.k_tangential
-            tau = kt * (jump[:, 1:] - committed.plastic_slip)
+            tau = self._trial_traction(jump, committed, lam_t)
             norm = np.linalg.norm(tau, axis=1)
             limit = self.friction * p
             # a relative margin keeps points exactly on the cone (e.g. re-evaluated after a
@@ -191,12 +244,15 @@ class SoftplusPenalty:
                 state.accumulated_slip[slipping] += np.abs(dslip)
                 state.slip_path[slipping] += (ns - ls) / kt
                 dissipation[slipping] = np.einsum("ij,ij->i", traction[slipping, 1:], dslip)
+        if self.augmented:
+            state.multiplier[:, 0] = p
+            state.multiplier[:, 1:] = traction[:, 1:]
         return LawResult(
             traction=traction,
             tangent=tangent,
             state=state,
             dissipation=dissipation,
-            area_fraction=expit(-jump[:, 0] / self.width),
+            area_fraction=expit(-(jump[:, 0] - shift) / self.width),
             contact=p > 0.0,
             slipping=slipping,
         )
@@ -220,7 +276,7 @@ class SoftplusPenalty:
         """
         if self.k_tangential <= 0.0:
             return result.tangent, None
-        tau = self.k_tangential * (jump[:, 1:] - committed.plastic_slip)
+        tau = self._trial_traction(jump, committed, self._shifts(committed)[1])
         norm = np.linalg.norm(tau, axis=1)
         m = np.divide(tau, norm[:, None], out=np.zeros_like(tau), where=norm[:, None] > 0.0)
         tangent = result.tangent

@@ -16,7 +16,7 @@ import numpy as np
 
 from .contract import LawResult, LawState
 
-__all__ = ["InterfaceState", "StatePair"]
+__all__ = ["InterfaceState", "AugmentedState", "StatePair"]
 
 
 @dataclass
@@ -59,6 +59,40 @@ class InterfaceState:
 
     def __len__(self) -> int:
         return self.plastic_slip.shape[0]
+
+
+@dataclass
+class AugmentedState(InterfaceState):
+    """History of an augmented-Lagrangian penalty law: :class:`InterfaceState` plus multipliers.
+
+    Attributes:
+        multiplier: (n, 3) [lambda_N, lambda_x, lambda_y]: the contact pressure lambda_N >= 0
+            and the tangential traction (lambda_x, lambda_y) the penalty is shifted by [MPa].
+            In a law evaluation they are the tractions of the trial point; in the committed
+            state, those of the last multiplier update (within an increment) or of the last
+            converged increment.
+    """
+
+    multiplier: np.ndarray = None
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        n = len(self)
+        if not isinstance(self.multiplier, np.ndarray) or self.multiplier.shape != (n, 3):
+            raise ValueError(f"AugmentedState.multiplier must be an ndarray of shape ({n}, 3), "
+                             f"got {np.shape(self.multiplier)}")
+
+    @classmethod
+    def zeros(cls, n_pts: int) -> AugmentedState:
+        """Virgin state (no slip, no hardening, zero multipliers) at n_pts points."""
+        base = InterfaceState.zeros(n_pts)
+        return cls(base.plastic_slip, base.accumulated_slip, base.slip_path,
+                   np.zeros((len(base), 3)))
+
+    def copy(self) -> AugmentedState:
+        """Deep copy."""
+        return AugmentedState(self.plastic_slip.copy(), self.accumulated_slip.copy(),
+                              self.slip_path.copy(), self.multiplier.copy())
 
 
 class StatePair:
@@ -111,7 +145,8 @@ class StatePair:
         self._pending = np.zeros_like(self.dissipated)
 
     def restore(self, committed: LawState, dissipated: np.ndarray) -> None:
-        """Set the committed state and the accumulated dissipation (resuming a checkpoint)."""
+        """Set the committed state and the accumulated dissipation, dropping the trial (resuming a
+        checkpoint; an augmented-Lagrangian multiplier update, or undoing one)."""
         if not isinstance(committed, LawState) or len(committed) != len(self.committed):
             raise ValueError(f"restored state ({type(committed).__name__}, "
                              f"{len(committed) if isinstance(committed, LawState) else '?'} "

@@ -146,7 +146,8 @@ def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5
         mu=0.3, penalty=1e8, half_width=4.0, height=4.0, mesh_size=1.0, preload_steps=2,
         shear_steps=12, cycles=0, indenter="paraboloid", quadrature_degree=None,
         k_tangential=None, ring_size=None, ring_band=(0.8, 1.05), width_ratio=1e-3,
-        comm=MPI.COMM_WORLD, verbose=False) -> dict:
+        augmented=False, augmentation_tolerance=1e-3, comm=MPI.COMM_WORLD,
+        verbose=False) -> dict:
     """Normal indentation by ``delta`` [mm], then a tangential bottom displacement: monotonic to
     ``slide`` [mm] (``cycles`` = 0) or ``cycles`` triangle cycles of amplitude ``slide``.
 
@@ -172,6 +173,10 @@ def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5
     default 1e-3 and k = 1e8) and points just outside the contact keep a small pressure
     while they slide by the whole tangential displacement: a dissipation linear in the
     amplitude, beside Mindlin's cubic one (docs/mindlin.md).
+
+    ``augmented``: exact contact and stick by the augmented-Lagrangian (Uzawa) iteration of
+    ``SoftplusPenalty(augmented=True)`` with ``augmentation_tolerance``; the penalties then
+    set only how fast the multipliers converge.
 
     ``slide`` defaults to the approach at which Mindlin's Q reaches mu P for Hertz's P at
     ``delta`` plus the block's shear compliance (so the last increments slide).
@@ -212,7 +217,8 @@ def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5
         k_tangential = KT_SCALE * E / contact_size
     check_scalar("k_tangential", k_tangential, lo=0.0, unit="MPa/mm")
     check_scalar("width_ratio", width_ratio, lo=0.0)
-    law = SoftplusPenalty(penalty, width_ratio * delta, k_tangential=k_tangential, friction=mu)
+    law = SoftplusPenalty(penalty, width_ratio * delta, k_tangential=k_tangential, friction=mu,
+                          augmented=augmented, augmentation_tolerance=augmentation_tolerance)
     if indenter not in ("paraboloid", "sphere"):
         raise ValueError(f"indenter = {indenter!r} is invalid: 'paraboloid' or 'sphere'")
     rigid = ParaboloidIndenter(radius) if indenter == "paraboloid" else \

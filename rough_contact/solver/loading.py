@@ -138,7 +138,10 @@ class Increment:
             iteration for a direct solver).
         linear_total: Krylov iterations spent since the previous converged step, failed
             attempts included.
-        failed_attempts: Newton solves that failed since the previous converged step.
+        failed_attempts: attempts of the step that failed since the previous converged step.
+        augmentations: multiplier updates of an augmented-Lagrangian law in the attempt that
+            converged (each followed by a Newton solve; ``iterations`` and
+            ``linear_iterations`` sum over all solves of the attempt); 0 for other laws.
         wall_time: seconds spent on this step (including failed attempts).
         linear_solver: KSP+PC used.
         n_beyond_validity: interface points outside the law's range of validity (see the
@@ -166,6 +169,7 @@ class Increment:
     linear_iterations: int = 0
     linear_total: int = 0
     failed_attempts: int = 0
+    augmentations: int = 0
 
 
 def load_unload_factors(n_load: int, n_unload: Optional[int] = None,
@@ -200,6 +204,7 @@ def _print_increment(inc: Increment) -> None:
         f"  step {inc.step:3d}  load {inc.load_factor:8.5f}  Newton {inc.iterations:2d}  "
         + (f"(spent {inc.newton_total}, {inc.failed_attempts} failed) "
            if inc.failed_attempts else "")
+        + (f"(AL updates {inc.augmentations}) " if inc.augmentations else "")
         + f"lin {inc.linear_iterations}"
         + (f" (spent {inc.linear_total})" if inc.failed_attempts else "")
         + "  "
@@ -337,7 +342,7 @@ def load_path(problem: ContactProblem, solver: SNESSolver, factors: Iterable[flo
                 problem.u.vector.axpy(r, u_committed)
                 problem.u.vector.axpy(-r, u_previous)
                 problem.u.x.scatter_forward()
-            ok, result, failure = _attempt(solver, comm)
+            ok, result, failure, updates = _solve_step(problem, solver, comm)
             spent[0] += result.iterations
             spent[1] += result.linear_iterations
             if ok:
@@ -361,7 +366,7 @@ def load_path(problem: ContactProblem, solver: SNESSolver, factors: Iterable[flo
                     cutbacks=cutbacks, wall_time=time.perf_counter() - t_start,
                     linear_solver=solver.linear_solver, newton_total=spent[0],
                     linear_iterations=result.linear_iterations, linear_total=spent[1],
-                    failed_attempts=spent[2])
+                    failed_attempts=spent[2], augmentations=updates)
                 spent = [0, 0, 0]
                 if interface is not None:
                     s = interface.summary()
@@ -470,12 +475,50 @@ def _validity_guard(inc: Increment, policy: str) -> None:
     warnings.warn(msg, ModelValidityWarning, stacklevel=3)
 
 
-def _attempt(solver: SNESSolver, comm: MPI.Comm):
-    """One Newton solve. Returns ``(converged on every rank, SolveResult or None, the
+def _solve_step(problem: ContactProblem, solver: SNESSolver, comm: MPI.Comm):
+    """Solve one load step: a Newton solve and, for an augmented-Lagrangian law
+    (``ContactInterface.augmentation()`` not None), Uzawa updates of its multipliers, each
+    followed by a Newton solve from the current iterate, until an update changes them by at
+    most the law's tolerance (then the last solve's trial state is the one to commit).
+
+    Returns:
+        (converged, SolveResult with iterations summed over the solves, the failure or None,
+        number of multiplier updates). More updates than the law's ``max_updates`` is a
+        failure (a ConvergenceError: the caller reverts, which also restores the multipliers,
+        and cuts back).
+    """
+    interface = problem.interface
+    control = None if interface is None else interface.augmentation()
+    ok, total, failure = _attempt(solver, comm)
+    updates = 0
+    while ok and control is not None:
+        problem.F(None, solver.x, problem.b)    # the law at the converged iterate
+        rel, updated = interface.augment(control.tolerance)
+        if not updated:
+            break
+        if updates >= control.max_updates:
+            failure = ConvergenceError(
+                f"augmented Lagrangian: the multipliers still moved by {rel:.3g} of the largest "
+                f"traction after {updates} updates (augmentation_tolerance "
+                f"{control.tolerance:g}, max_augmentations {control.max_updates}); a stiffer "
+                "penalty needs fewer updates")
+            return False, total, failure, updates
+        updates += 1
+        first = total.residuals[0] if total.residuals else 0.0
+        ok, result, failure = _attempt(solver, comm, atol=solver.snes.getTolerances()[0] * first)
+        total = SolveResult(result.converged, result.reason, result.reason_name,
+                            total.iterations + result.iterations,
+                            total.residuals + result.residuals,
+                            total.linear_iterations + result.linear_iterations)
+    return ok, total, failure, updates
+
+
+def _attempt(solver: SNESSolver, comm: MPI.Comm, atol: Optional[float] = None):
+    """One Newton solve (``atol``: see ``SNESSolver.solve``). Returns ``(converged on every rank, SolveResult or None, the
     ConvergenceError or None)``; every other exception propagates."""
     failure = None
     try:
-        result = solver.solve()
+        result = solver.solve() if atol is None else solver.solve(atol=atol)
         ok = result.converged
     except ConvergenceError as exc:
         # raised on every rank together by the interface (rough_contact.fem.collective)

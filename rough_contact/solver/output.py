@@ -157,6 +157,7 @@ _CSV_COLUMNS = [
     ("n_beyond_validity", "n_beyond_validity"),
     ("newton_its_spent", "newton_total"), ("linear_its", "linear_iterations"),
     ("linear_its_spent", "linear_total"), ("failed_attempts", "failed_attempts"),
+    ("al_updates", "augmentations"),
 ]
 
 

@@ -272,10 +272,16 @@ class SNESSolver:
             name += f"({pc.getFactorSolverType()})"
         return name
 
-    def solve(self) -> SolveResult:
+    def solve(self, atol: Optional[float] = None) -> SolveResult:
         """Solve F(u) = 0 starting from ``problem.u``; on success ``problem.u`` holds the root.
 
         On failure ``problem.u`` holds the last iterate: the caller reverts it.
+
+        Args:
+            atol: if given, the absolute residual tolerance of this solve is at least this [N]
+                (the augmented-Lagrangian re-solves of a load step use the first solve's
+                rtol x initial residual: a re-solve starts from a small residual, and its
+                own rtol would ask for more accuracy than the step's first solve reached).
 
         Raises:
             Exception: whatever a callback raised (the same object, e.g. a ConvergenceError
@@ -295,9 +301,19 @@ class SNESSolver:
             u_inf = max(self.x.norm(PETSc.NormType.INFINITY), 1e-30)
             floor = 10.0 * np.finfo(float).eps * self._k_norm_inf * u_inf
             self.snes.setTolerances(atol=max(self._atol0, floor))
+        atol_before = None
+        if atol is not None:
+            atol_now = self.snes.getTolerances()[1]
+            if atol > atol_now:
+                atol_before = atol_now
+                self.snes.setTolerances(atol=atol)
         # Some options are read only when the preconditioner is set up, inside the solve.
-        with self._options():
-            self.snes.solve(None, self.x)
+        try:
+            with self._options():
+                self.snes.solve(None, self.x)
+        finally:
+            if atol_before is not None:
+                self.snes.setTolerances(atol=atol_before)
         reason = self.snes.getConvergedReason()
         self.problem.update_solution(self.x)
         res = list(self._residuals)
