@@ -43,6 +43,7 @@ Units: mm, N, MPa. Positions and jumps [mm], tractions [MPa], forces [N], areas 
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, replace
 from typing import Optional, Sequence, Tuple, Union
 
@@ -1304,6 +1305,14 @@ def _check_arguments(V, law, first_tag, second_tag, rigid_plane, quadrature_degr
     if quadrature == "vertex" and element.degree != 1:
         raise ValueError(f"quadrature = 'vertex' needs a degree-1 space (P1/Q1), got degree "
                          f"{element.degree}: use a Gauss rule for P2/Q2")
+    if (quadrature == "gauss" and element.degree == 1 and degree >= 2
+            and isinstance(law, AugmentedLagrangianLaw) and law.augmentation() is not None):
+        warnings.warn(
+            f"an augmented-Lagrangian law enforces its constraints exactly at every point: a "
+            f"Gauss rule of degree {int(degree)} puts several points on each degree-1 facet, "
+            "more constraints than surface nodes, and the multiplier iteration may not "
+            "converge where stick and slip meet (docs/coulomb.md); use quadrature='vertex'",
+            UserWarning, stacklevel=3)
     grain = np.asarray(grain_direction, dtype=float)
     if grain.shape != (3,) or not np.all(np.isfinite(grain)) or np.linalg.norm(grain) == 0:
         raise ValueError(f"grain_direction = {grain_direction!r} must be a nonzero 3-vector")

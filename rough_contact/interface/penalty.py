@@ -119,7 +119,9 @@ class SoftplusPenalty:
         augmented: enforce the contact and stick constraints exactly by an augmented-
             Lagrangian (Uzawa) iteration on the multipliers (see above); False = plain penalty.
         augmentation_tolerance: convergence of the multipliers, relative to the largest traction
-            magnitude of the interface (0 < tol < 1) [-].
+            magnitude of the interface (0 < tol < 1) [-]. Keep it above about 1e-8: the Newton
+            solves are accurate to rtol 1e-9 of the step's first residual, and the multiplier
+            changes stall there.
         max_augmentations: multiplier updates per load increment (>= 1) before the increment
             counts as not converged (cutback).
     """
