@@ -362,6 +362,7 @@ class ContactInterface:
         self._last_u = self._last = self._last_jump = None
         self._newton_memo = None   # a law's newton_tangent memo within one Newton solve
         self._augment_base = None  # committed state before this increment's multiplier updates
+        self._multipliers_before = None  # committed state the last converged increment began at
         self._cache_valid = False
         self._result_checked = False  # the first evaluation's result is checked in full
 
@@ -1087,10 +1088,43 @@ class ContactInterface:
         """
         if u is not None:
             self.evaluate(u)
+        if self.augmentation() is not None:   # the multipliers this increment started from
+            self._multipliers_before = (self._augment_base if self._augment_base is not None
+                                        else self.history.committed)
         self.history.commit()
         self._cache_valid = False  # a new committed state: never reuse the old evaluation
         self._newton_memo = None
         self._augment_base = None
+
+    def predictor_state(self):
+        """What :meth:`extrapolate_multipliers` needs from the past (the committed state the
+        last converged increment started from, or None); a checkpoint stores it."""
+        return self._multipliers_before
+
+    def restore_predictor_state(self, state) -> None:
+        """Set what :meth:`predictor_state` returned (resuming a checkpoint)."""
+        if state is not None and (not isinstance(state, LawState)
+                                  or len(state) != len(self.history.committed)):
+            raise ValueError(f"predictor state ({type(state).__name__}) must be None or a "
+                             f"LawState of {len(self.history.committed)} points")
+        self._multipliers_before = state
+
+    def extrapolate_multipliers(self, ratio: float) -> bool:
+        """Secant predictor of an augmented-Lagrangian law's multipliers (no communication):
+        lambda_n + ratio (lambda_n - lambda_{n-1}), the committed state's multipliers and those
+        the last converged increment started from. :meth:`revert` undoes it. Returns whether
+        anything was done (not for a plain law, nor before the second converged increment)."""
+        if self.augmentation() is None or self._multipliers_before is None:
+            return False
+        check_scalar("ratio", ratio)
+        new = self.law.extrapolate(self.history.committed, self._multipliers_before, ratio)
+        if self._augment_base is None:
+            self._augment_base = self.history.committed
+        self.history.restore(new, self.history.dissipated)
+        self._last = None
+        self._cache_valid = False
+        self._newton_memo = None
+        return True
 
     def revert(self) -> None:
         """Discard the trial state (failed increment, before a cutback), and the multiplier

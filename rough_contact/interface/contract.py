@@ -240,7 +240,9 @@ class AugmentedLagrangianLaw(Protocol):
     """A penalty law whose constraints are enforced exactly by multipliers updated between
     Newton solves (Uzawa's augmented-Lagrangian iteration).
 
-    Within one Newton solve the multipliers are held in the committed state; after the solve
+    Within one Newton solve the multipliers are held in the committed state (at the start of
+    an increment extrapolated from the last two by :meth:`extrapolate`, with the secant
+    predictor); after the solve
     converged the load stepping (``rough_contact.solver.loading``) asks the interface for an
     update, which calls :meth:`augment`; if the multipliers moved by more than the tolerance
     of :meth:`augmentation` it solves again with the updated ones, else it commits. A failed
@@ -255,6 +257,13 @@ class AugmentedLagrangianLaw(Protocol):
         """(``committed`` with its multipliers replaced by those of ``result``, the (n,)
         magnitude of each point's multiplier change [MPa]); pure, keeps every other history
         variable of ``committed``."""
+        ...
+
+    def extrapolate(self, committed: LawState, previous: LawState, ratio: float) -> LawState:
+        """``committed`` with its multipliers extrapolated linearly from ``previous`` (the
+        committed state the last converged increment started from): lambda + ratio (lambda -
+        lambda_previous); pure. The load stepping's secant predictor calls it at the start of
+        an increment; the converged result does not depend on it."""
         ...
 
 

@@ -175,6 +175,19 @@ class SoftplusPenalty:
         new.multiplier = result.state.multiplier.copy()
         return new, np.linalg.norm(new.multiplier - committed.multiplier, axis=1)
 
+    def extrapolate(self, committed: InterfaceState, previous: InterfaceState, ratio: float
+                    ) -> InterfaceState:
+        """``committed`` with the multipliers extrapolated linearly in the load,
+        lambda + ratio (lambda - lambda_previous); pure. Plastic slip and hardening stay."""
+        if not (self.augmented and isinstance(committed, AugmentedState)
+                and isinstance(previous, AugmentedState) and len(previous) == len(committed)):
+            raise ValueError("extrapolate needs augmented=True and two AugmentedState histories "
+                             "of the same points")
+        new = committed.copy()
+        new.multiplier += ratio * (committed.multiplier - previous.multiplier)
+        new.multiplier[:, 0] = np.maximum(new.multiplier[:, 0], 0.0)
+        return new
+
     def _shifts(self, committed: InterfaceState) -> tuple[np.ndarray, np.ndarray]:
         """(gap shift lambda_N / k_N (n,) [mm] or 0, tangential multiplier (n, 2) [MPa] or 0)."""
         if self.augmented:

@@ -4,7 +4,8 @@
 before it is yielded, everything the stepping needs to continue exactly: the displacement, the
 interface's committed law state and accumulated dissipation, the load factor, the position in
 the list of load factors (index, current increment size, cutbacks) and the secant predictor's
-previous state. ``load_path(..., resume=DIR)`` restores it into a freshly built problem (same
+previous state (the displacement, and for an augmented-Lagrangian law the multipliers the
+last increment started from). ``load_path(..., resume=DIR)`` restores it into a freshly built problem (same
 mesh, same number of ranks, same law) and continues; the resumed run reproduces the uninterrupted
 one to round-off (tests/fem/test_checkpoint.py).
 
@@ -106,7 +107,8 @@ def write_checkpoint(directory: str, problem, state: CheckpointState, sig: dict,
                 committed=None if ci is None else ci.history.committed,
                 dissipated=None if ci is None else ci.history.dissipated,
                 outputs=[o.checkpoint_state() for o in outputs],
-                pairing=None if ci is None else ci.pairing_state())
+                pairing=None if ci is None else ci.pairing_state(),
+                interface_predictor=None if ci is None else ci.predictor_state())
     with open(os.path.join(path, f"rank{comm.rank}.pkl"), "wb") as f:
         pickle.dump(data, f, protocol=pickle.HIGHEST_PROTOCOL)
         f.flush()
@@ -212,6 +214,7 @@ def read_checkpoint(directory: str, problem, factors,
     if ci is not None:
         ci.history.restore(data["committed"], data["dissipated"])
         ci.revert()
+        ci.restore_predictor_state(data.get("interface_predictor"))
         if ci.restore_pairing(data.get("pairing"), problem.u):   # moderate sliding
             problem.rebuild_matrices()
     for writer, saved in zip(outputs, saved_outputs):

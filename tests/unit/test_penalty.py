@@ -250,3 +250,21 @@ def test_augmented_control_and_bad_input():
     with pytest.raises(ValueError, match="augmented=True"):
         plain.augment(plain.initial_state(1), plain.evaluate(np.zeros((1, 3)),
                                                              plain.initial_state(1)))
+
+
+def test_augmented_extrapolate():
+    """The secant predictor of the multipliers: lambda + r (lambda - lambda_previous), the
+    pressure kept >= 0, the rest of the history untouched; pure."""
+    law = SoftplusPenalty(k_normal=1e4, width=1e-4, k_tangential=1e4, friction=0.3,
+                          augmented=True)
+    prev, now = law.initial_state(2), law.initial_state(2)
+    prev.multiplier[:] = [[1.0, 0.1, 0.0], [0.5, 0.0, 0.0]]
+    now.multiplier[:] = [[2.0, 0.3, -0.1], [0.2, 0.0, 0.0]]
+    now.plastic_slip[:] = [[1e-3, 0.0], [0.0, 2e-3]]
+    new = law.extrapolate(now, prev, 0.5)
+    np.testing.assert_allclose(new.multiplier, [[2.5, 0.4, -0.15], [0.05, 0.0, 0.0]])
+    np.testing.assert_allclose(law.extrapolate(now, prev, 1.0).multiplier[1], [0.0, 0.0, 0.0])
+    np.testing.assert_array_equal(new.plastic_slip, now.plastic_slip)
+    assert now.multiplier[0, 0] == 2.0
+    with pytest.raises(ValueError, match="extrapolate needs"):
+        law.extrapolate(now, law.initial_state(3), 0.5)
