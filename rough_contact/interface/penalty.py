@@ -108,6 +108,21 @@ class SoftplusPenalty:
     iterations at level 1, 237 -> 202 at level 3). ``reversal_stiffness = 0`` gives the
     consistent tangent everywhere.
 
+    Augmented Lagrangian (``augmented=True``; Uzawa's iteration, for friction Simo and
+    Laursen's scheme): the penalty is shifted by multipliers kept in the history
+    (:class:`~rough_contact.interface.state.AugmentedState`), p = k_N w softplus((lambda_N /
+    k_N - g) / w) and tau = lambda_T + k_T (s - s_p), with the same radial return. The load
+    stepping re-solves each increment with the multipliers replaced by the tractions of the
+    converged solution (:meth:`augment`) until they stop moving (``augmentation_tolerance`` of
+    the largest traction). At that fixed point k_N g -> 0 in contact (up to the softplus
+    smoothing) and s = s_p: a sticking point does not move, a slipping point slips only
+    plastically, so the result no longer depends on k_N, k_T (docs/coulomb.md); the penalty
+    sets only how fast the multipliers converge. The committed multipliers (the converged
+    tractions: a stuck point keeps its traction with zero elastic slip) start the next
+    increment, extrapolated in the load by the load stepping's secant predictor
+    (:meth:`extrapolate`). The virgin state has zero multipliers. On P1/Q1 facets use the
+    vertex rule: exact constraints at several Gauss points per facet lock.
+
     Args:
         k_normal: normal stiffness k_N > 0 [MPa/mm].
         width: smoothing length w > 0 [mm].
