@@ -1117,14 +1117,19 @@ class ContactInterface:
         if self.augmentation() is None or self._multipliers_before is None:
             return False
         check_scalar("ratio", ratio)
-        new = self.law.extrapolate(self.history.committed, self._multipliers_before, ratio)
+        self._replace_multipliers(
+            self.law.extrapolate(self.history.committed, self._multipliers_before, ratio))
+        return True
+
+    def _replace_multipliers(self, new) -> None:
+        """Make ``new`` the committed state of this increment (multipliers changed), keeping
+        the state the increment started from for :meth:`revert`; drop the trial state."""
         if self._augment_base is None:
             self._augment_base = self.history.committed
         self.history.restore(new, self.history.dissipated)
         self._last = None
         self._cache_valid = False
         self._newton_memo = None
-        return True
 
     def revert(self) -> None:
         """Discard the trial state (failed increment, before a cutback), and the multiplier
@@ -1172,12 +1177,7 @@ class ContactInterface:
         rel = top_change / top_traction if top_traction > 0.0 else 0.0
         if rel <= tolerance:
             return rel, False
-        if self._augment_base is None:
-            self._augment_base = self.history.committed
-        self.history.restore(new, self.history.dissipated)
-        self._last = None
-        self._cache_valid = False
-        self._newton_memo = None
+        self._replace_multipliers(new)
         return rel, True
 
     def begin_solve(self) -> None:
