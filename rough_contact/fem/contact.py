@@ -320,6 +320,9 @@ class ContactInterface:
         self.first_tag, self.second_tag = first_tag, second_tag
         n_owned_facets = _facet_connectivity(V.mesh)
         rule = _FacetRule.create(V.mesh, degree, vertex=quadrature == "vertex")
+        if quadrature == "gauss":
+            _warn_overconstrained(law, rule.nq, V.mesh.topology.cell_type,
+                                  V.ufl_element().degree(), degree)
         geo1 = _FacetGeometry(V, _owned_tagged_facets(facet_tags, first_tag, n_owned_facets,
                                                       self.comm))
         self._facets1 = geo1.facets
@@ -1339,14 +1342,6 @@ def _check_arguments(V, law, first_tag, second_tag, rigid_plane, quadrature_degr
     if quadrature == "vertex" and element.degree != 1:
         raise ValueError(f"quadrature = 'vertex' needs a degree-1 space (P1/Q1), got degree "
                          f"{element.degree}: use a Gauss rule for P2/Q2")
-    if (quadrature == "gauss" and element.degree == 1 and degree >= 2
-            and isinstance(law, AugmentedLagrangianLaw) and law.augmentation() is not None):
-        warnings.warn(
-            f"an augmented-Lagrangian law enforces its constraints exactly at every point: a "
-            f"Gauss rule of degree {int(degree)} puts several points on each degree-1 facet, "
-            "more constraints than surface nodes, and the multiplier iteration may not "
-            "converge where stick and slip meet (docs/coulomb.md); use quadrature='vertex'",
-            UserWarning, stacklevel=3)
     grain = np.asarray(grain_direction, dtype=float)
     if grain.shape != (3,) or not np.all(np.isfinite(grain)) or np.linalg.norm(grain) == 0:
         raise ValueError(f"grain_direction = {grain_direction!r} must be a nonzero 3-vector")
@@ -1497,6 +1492,35 @@ _CELLS = {
     dolfinx.mesh.CellType.tetrahedron: (basix.CellType.tetrahedron, basix.CellType.triangle),
     dolfinx.mesh.CellType.hexahedron: (basix.CellType.hexahedron, basix.CellType.quadrilateral),
 }
+
+
+# surface nodes per surface facet of a large surface mesh (triangles: V ~ F / 2, E ~ 3F / 2;
+# quadrilaterals: V ~ F, E ~ 2F), by (cell type, element degree)
+_NODES_PER_FACET = {
+    (dolfinx.mesh.CellType.tetrahedron, 1): 0.5, (dolfinx.mesh.CellType.tetrahedron, 2): 2.0,
+    (dolfinx.mesh.CellType.hexahedron, 1): 1.0, (dolfinx.mesh.CellType.hexahedron, 2): 4.0,
+}
+
+
+def _warn_overconstrained(law, n_points: int, cell_type, element_degree: int,
+                          rule_degree: int) -> None:
+    """Warn when an augmented-Lagrangian law would enforce its constraints exactly at more
+    points per facet than there are surface nodes per facet (they lock: the multiplier
+    iteration stalls, docs/coulomb.md)."""
+    if not (isinstance(law, AugmentedLagrangianLaw) and law.augmentation() is not None):
+        return
+    nodes = _NODES_PER_FACET.get((cell_type, element_degree))
+    if nodes is None or n_points <= nodes:
+        return
+    fix = ("use quadrature='vertex'" if element_degree == 1 else
+           f"use a facet rule of at most {int(nodes)} point(s) per facet (quadrature_degree=1 "
+           "on triangles), or a P1/Q1 mesh with the vertex rule")
+    warnings.warn(
+        f"an augmented-Lagrangian law enforces its constraints exactly at every point: the "
+        f"Gauss rule of degree {int(rule_degree)} puts {n_points} points on each facet, about "
+        f"{n_points / nodes:g} times the surface nodes of a degree-{element_degree} mesh; the "
+        "constraints lock and the multiplier iteration may not converge where contact or stick "
+        f"ends (docs/coulomb.md); {fix}", UserWarning, stacklevel=3)
 
 
 def _read_only(a: np.ndarray) -> np.ndarray:
