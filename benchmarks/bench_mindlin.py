@@ -56,7 +56,7 @@ def stick(levels, kt=None, kt_scale=None):
 
 
 def energy(levels, amplitudes, kt=None, kt_scale=None, ring_size=None, ring_band=(0.8, 1.05),
-           width_ratio=1e-3, augmented=False, quadrature_degree=None):
+           width_ratio=1e-3, augmented=False, quadrature_degree=None, verbose=False):
     PETSc.Sys.Print(f"{'h':>6} {'DOFs':>7} {'ampl':>5} {'Q*/muP':>6} {'W FE':>10} {'loop':>10} "
                     f"{'W MD':>10} {'error':>7} {'Newton':>6} {'time s':>6}")
     G = E / (2 * (1 + NU))
@@ -67,7 +67,8 @@ def energy(levels, amplitudes, kt=None, kt_scale=None, ring_size=None, ring_band
                             cycles=2, shear_steps=16, k_tangential=_kt(h, kt, kt_scale),
                             ring_size=None if ring_size is None else h * ring_size,
                             ring_band=tuple(ring_band), width_ratio=width_ratio,
-                            augmented=augmented, quadrature_degree=quadrature_degree)
+                            augmented=augmented, quadrature_degree=quadrature_degree,
+                            verbose=verbose)
             t, s, Q, D = r["t"], r["slide"], r["Q"], r["dissipation"]
             end1 = int(np.argmin(np.abs(t - 2.0)))
             idx = np.arange(end1, t.size)
@@ -102,12 +103,16 @@ def main(argv=None):
     ap.add_argument("--quadrature-degree", type=int, default=None,
                     help="energy: facet Gauss rule degree (default 2 x order = 4; 1 = one point "
                     "per facet, the rule the augmented Lagrangian converges with on P2)")
+    ap.add_argument("--verbose", action="store_true",
+                    help="energy: print every increment (Newton iterations, multiplier updates, "
+                    "cutbacks)")
     args = ap.parse_args(argv)
     if args.part in ("stick", "all"):
         stick(args.levels, args.k_tangential, args.kt_scale)
     if args.part in ("energy", "all"):
         energy(args.levels, args.amplitudes, args.k_tangential, args.kt_scale, args.ring,
-               args.ring_band, args.width_ratio, args.augmented, args.quadrature_degree)
+               args.ring_band, args.width_ratio, args.augmented, args.quadrature_degree,
+               args.verbose)
 
 
 if __name__ == "__main__":

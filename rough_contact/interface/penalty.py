@@ -203,17 +203,18 @@ class SoftplusPenalty:
         new.multiplier[:, 0] = np.maximum(new.multiplier[:, 0], 0.0)
         return new
 
-    def _shifts(self, committed: InterfaceState) -> tuple[np.ndarray, np.ndarray]:
-        """(gap shift lambda_N / k_N (n,) [mm] or 0, tangential multiplier (n, 2) [MPa] or 0)."""
+    def _shifts(self, committed: InterfaceState):
+        """(gap shift lambda_N / k_N (n,) [mm], tangential multiplier (n, 2) [MPa]); the scalar
+        0.0 for both when the law is not augmented."""
         if self.augmented:
             if not isinstance(committed, AugmentedState):
                 raise ValueError("augmented=True needs the AugmentedState of initial_state, got "
                                  f"{type(committed).__name__}")
             return committed.multiplier[:, 0] / self.k_normal, committed.multiplier[:, 1:]
-        return np.zeros(len(committed)), np.zeros((len(committed), 2))
+        return 0.0, 0.0
 
     def _trial_traction(self, jump: np.ndarray, committed: InterfaceState,
-                        lam_t: np.ndarray) -> np.ndarray:
+                        lam_t) -> np.ndarray:
         """Elastic predictor tau = lambda_T + k_T (s - s_p) (n, 2) [MPa]."""
         return lam_t + self.k_tangential * (jump[:, 1:] - committed.plastic_slip)
 

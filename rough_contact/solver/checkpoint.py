@@ -5,9 +5,9 @@ before it is yielded, everything the stepping needs to continue exactly: the dis
 interface's committed law state and accumulated dissipation, the load factor, the position in
 the list of load factors (index, current increment size, cutbacks) and the secant predictor's
 previous state (the displacement, and for an augmented-Lagrangian law the multipliers the
-last increment started from). ``load_path(..., resume=DIR)`` restores it into a freshly built problem (same
-mesh, same number of ranks, same law) and continues; the resumed run reproduces the uninterrupted
-one to round-off (tests/fem/test_checkpoint.py).
+last increment started from). ``load_path(..., resume=DIR)`` restores it into a freshly built
+problem (same mesh, same number of ranks, same law) and continues; the resumed run reproduces
+the uninterrupted one to round-off (tests/fem/test_checkpoint.py).
 
 Output writers given as ``load_path(..., outputs=[...])`` (:class:`ResumableOutput`, e.g.
 ``ResultWriter``) are part of the checkpoint: the checkpoint of increment k is written when the

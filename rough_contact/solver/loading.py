@@ -497,7 +497,7 @@ def _solve_step(problem: ContactProblem, solver: SNESSolver, comm: MPI.Comm):
     ok, total, failure = _attempt(solver, comm)
     updates = 0
     while ok and control is not None:
-        problem.F(None, solver.x, problem.b)    # the law at the converged iterate
+        interface.evaluate(problem.u)    # the law at the converged iterate (cached if there)
         rel, updated = interface.augment(control.tolerance)
         if not updated:
             break
@@ -519,8 +519,9 @@ def _solve_step(problem: ContactProblem, solver: SNESSolver, comm: MPI.Comm):
 
 
 def _attempt(solver: SNESSolver, comm: MPI.Comm, atol: Optional[float] = None):
-    """One Newton solve (``atol``: see ``SNESSolver.solve``). Returns ``(converged on every rank, SolveResult or None, the
-    ConvergenceError or None)``; every other exception propagates."""
+    """One Newton solve (``atol``: see ``SNESSolver.solve``). Returns ``(converged on every
+    rank, SolveResult or None, the ConvergenceError or None)``; every other exception
+    propagates."""
     failure = None
     try:
         result = solver.solve() if atol is None else solver.solve(atol=atol)

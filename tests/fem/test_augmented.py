@@ -5,6 +5,9 @@ Serial and on 2 ranks (every figure compared is partition-independent)."""
 
 from __future__ import annotations
 
+import contextlib
+import warnings
+
 import numpy as np
 import pytest
 from mpi4py import MPI
@@ -59,18 +62,15 @@ def _on_plane(scene, V, augmented, k, **kwargs):
     else:
         # 6 Gauss points per P2 facet: over-constrained where stick ends (the interface warns);
         # this block sticks everywhere, so the exact solution is still reached
-        with pytest.warns(UserWarning, match="constraints lock") if augmented else _no_warning():
+        expected = (pytest.warns(UserWarning, match="constraints lock") if augmented
+                    else contextlib.nullcontext())
+        with expected:
             ci = ContactInterface(V, scene.facet_tags, scene.tag("contact"), law=law,
                                   rigid_plane=scene.rigid_plane, quadrature_degree=2 * order)
     problem = ContactProblem(V, Material(E, NU), [], _load(scene), facet_tags=scene.facet_tags,
                              interface=ci)
     solver = SNESSolver(problem, prefix="aug_plane_")
     return problem, solver, ci
-
-
-def _no_warning():
-    import contextlib
-    return contextlib.nullcontext()
 
 
 def _max_diff(u, v):
@@ -209,8 +209,6 @@ def test_overconstraining_gauss_rule_warns(order):
     """Exact constraints at more points per facet than surface nodes per facet (P1: 3 Gauss
     points against 0.5 nodes; P2: 3 against 2) lock: the interface warns and names the
     remedy. The vertex rule (P1), a 1-point rule (P2) and a plain penalty do not warn."""
-    import warnings
-
     scene, V = _block(order)
     law = SoftplusPenalty(k_normal=1e5, width=1e-9, k_tangential=1e5, friction=MU,
                           augmented=True)
