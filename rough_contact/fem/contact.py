@@ -325,7 +325,8 @@ class ContactInterface(InterfaceQueries):
             top[:] = update.change.max(), np.linalg.norm(res.traction, axis=1).max()
         self.comm.Allreduce(MPI.IN_PLACE, top, op=MPI.MAX)
         rel = top[0] / top[1] if top[1] > 0.0 else 0.0
-        if rel <= self.enforcement.tolerance:
+        if rel <= self.enforcement.tolerance:      # the commit starts the next increment
+            self.history.propose_multipliers(update.multipliers)   # from the tractions
             return Acceptance(True, rel)
         self.history.set_multipliers(update.multipliers)
         self._forget()

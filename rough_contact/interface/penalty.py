@@ -53,10 +53,8 @@ class LinearPenalty:
         """Virgin history at n_pts points (this law keeps none: the state is carried unchanged)."""
         return InterfaceState.zeros(n_pts)
 
-    def evaluate(self, jump: np.ndarray, committed: InterfaceState,
-                 multipliers: Optional[np.ndarray] = None) -> LawResult:
+    def evaluate(self, jump: np.ndarray, committed: InterfaceState) -> LawResult:
         """Traction (n, 3) and tangent (n, 3, 3) at jump (n, 3) [mm]; pure (no mutation).
-        ``multipliers`` (n, 3) shift the penalty (see the class; None: the plain penalty).
 
         Raises:
             ValueError: wrong shapes. ConvergenceError: non-finite jump.
@@ -129,104 +127,6 @@ class SoftplusPenalty:
         reversal_stiffness: factor >= 0 [-] of the secant stiffness added along m at points
             whose slip direction reversed between two Jacobians (Newton steps only, see
             above; 0 = off).
-    """
-
-    k_normal: float
-    k_tangential: float = 0.0
-    unilateral: bool = False
-
-    def __post_init__(self) -> None:
-        check_scalar("k_normal", self.k_normal, lo=0.0, unit="MPa/mm")
-        check_scalar("k_tangential", self.k_tangential, lo=0.0, lo_open=False, unit="MPa/mm")
-
-    def initial_state(self, n_pts: int) -> InterfaceState:
-        """Virgin history at n_pts points (this law keeps none: the state is carried unchanged)."""
-        return InterfaceState.zeros(n_pts)
-
-    def evaluate(self, jump: np.ndarray, committed: InterfaceState,
-                 multipliers: Optional[np.ndarray] = None) -> LawResult:
-        """Traction (n, 3) and tangent (n, 3, 3) at jump (n, 3) [mm]; pure (no mutation).
-        ``multipliers`` (n, 3) shift the penalty (see the class; None: the plain penalty).
-
-        Raises:
-            ValueError: wrong shapes. ConvergenceError: non-finite jump.
-        """
-        jump = _check_inputs(jump, committed)
-        n = jump.shape[0]
-        g = jump[:, 0]
-        active = (g <= 0.0) if self.unilateral else np.ones(n, dtype=bool)
-        kn = np.where(active, self.k_normal, 0.0)
-        kt = np.where(active, self.k_tangential, 0.0)
-        traction = np.empty((n, 3))
-        traction[:, 0] = kn * g
-        traction[:, 1:] = kt[:, None] * jump[:, 1:]
-        tangent = np.zeros((n, 3, 3))
-        tangent[:, 0, 0] = kn
-        tangent[:, 1, 1] = kt
-        tangent[:, 2, 2] = kt
-        contact = -traction[:, 0] > 0.0
-        return LawResult(
-            traction=traction,
-            tangent=tangent,
-            state=committed.copy(),
-            dissipation=np.zeros(n),
-            area_fraction=contact.astype(float),
-            contact=contact,
-            slipping=np.zeros(n, dtype=bool),
-        )
-
-
-@dataclass(frozen=True)
-class SoftplusPenalty:
-    """Smooth unilateral penalty with optional isotropic Coulomb friction.
-
-    Normal: p(g) = k_N w softplus(-g / w) = k_N w ln(1 + exp(-g / w)), so p -> k_N (-g) for
-    g << -w, p -> 0 for g >> w, and k = -dp/dg = k_N sigmoid(-g / w) (C-infinity).
-    Tangential: elastic predictor tau = k_T (s - s_p); if |tau| > mu p the point slips
-    (radial return): t_T = mu p tau / |tau|, s_p += (|tau| - mu p) / k_T * tau / |tau|.
-    The tangent is the consistent (non-symmetric) one. ``area_fraction`` = sigmoid(-g / w)
-    is a toy measure (0 far open, 1 deep in contact).
-
-    Newton steps (:meth:`newton_tangent`, used by the FE interface for the Jacobian only): the
-    consistent tangent of a slipping point, k_T mu p / |tau| (I - m m^T), has no stiffness
-    along the slip direction m, so a Newton step can drive the trial traction tau through zero
-    and reverse the slip direction of a point (seen on the unloading branch of the flat punch:
-    ~100 of 1 500 points per iteration, the backtracking line search then cuts the steps to
-    15-25 %). A point that is slipping and whose trial direction reversed (m . m_prev < 0)
-    since the previous Jacobian of the same Newton solve gets the secant stiffness
-    ``reversal_stiffness`` x k_T mu p / |tau| along m in that Jacobian. The residual is
-    unchanged, so is the converged solution; points that stopped reversing get the consistent
-    tangent back, so the final iterations stay quadratic (docs/coulomb.md: 173 -> 146 Newton
-    iterations at level 1, 237 -> 202 at level 3). ``reversal_stiffness = 0`` gives the
-    consistent tangent everywhere.
-
-    Multipliers (:class:`~rough_contact.interface.contract.MultiplierLaw`): ``with_multipliers``
-    gives the law with its penalty shifted by multipliers lambda = (lambda_N, lambda_x,
-    lambda_y), p = k_N w softplus((lambda_N / k_N - g) / w) and tau = lambda_T + k_T (s - s_p),
-    with the same radial return. The augmented-Lagrangian enforcement
-    (``rough_contact.interface.enforcement.AugmentedLagrangian``; Uzawa's iteration, for
-    friction Simo and Laursen's scheme) re-solves each increment with lambda replaced by the
-    converged tractions until they stop moving. At that fixed point k_N g -> 0 in contact (up
-    to the softplus smoothing) and s = s_p: a sticking point does not move, a slipping point
-    slips only plastically, so the result no longer depends on k_N, k_T (docs/coulomb.md); the
-    penalty sets only how fast the multipliers converge.
-
-    Args:
-        k_normal: normal stiffness k_N > 0 [MPa/mm].
-        width: smoothing length w > 0 [mm].
-        k_tangential: tangential stiffness k_T >= 0 [MPa/mm].
-        friction: Coulomb coefficient mu >= 0 [-] (needs k_T > 0 to matter).
-        reversal_stiffness: factor >= 0 [-] of the secant stiffness added along m at points
-            whose slip direction reversed between two Jacobians (Newton steps only, see
-            above; 0 = off).
-        augmented: enforce the contact and stick constraints exactly by an augmented-
-            Lagrangian (Uzawa) iteration on the multipliers (see above); False = plain penalty.
-        augmentation_tolerance: convergence of the multipliers, relative to the largest traction
-            magnitude of the interface (0 < tol < 1) [-]. Keep it above about 1e-8: the Newton
-            solves are accurate to rtol 1e-9 of the step's first residual, and the multiplier
-            changes stall there.
-        max_augmentations: multiplier updates per load increment (>= 1) before the increment
-            counts as not converged (cutback).
     """
 
     k_normal: float

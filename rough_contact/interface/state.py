@@ -137,9 +137,10 @@ class InterfaceHistory:
     """Everything an interface remembers between increments, in one object.
 
     * the law's history (:class:`StatePair`: committed and trial state, dissipation);
-    * the multipliers of an enforcement that has them (committed; those the increment started
-      from, to undo its updates on a revert; those the last converged increment started from,
-      for the secant predictor);
+    * the multipliers of an enforcement that has them (committed; the trial ones, the tractions
+      of the accepted iterate, which the commit makes the next increment's start; those the
+      increment started from, to undo its updates on a revert; those the last converged
+      increment started from, for the secant predictor);
     * the pairing of a sliding pairing (an opaque, picklable object and the jump offsets it
       set), None for a fixed pairing.
 
@@ -156,6 +157,7 @@ class InterfaceHistory:
         self.multipliers = None if multipliers is None else np.asarray(multipliers, float)
         self.multipliers_before: Optional[np.ndarray] = None
         self._multipliers_start: Optional[np.ndarray] = None
+        self._multipliers_trial: Optional[np.ndarray] = None
         self.pairing: Optional[object] = None
 
     # ------------------------------------------------------------------ lifecycle
@@ -168,7 +170,16 @@ class InterfaceHistory:
         if self._multipliers_start is None:
             self._multipliers_start = self.multipliers
         self.multipliers = new
+        self._multipliers_trial = None
         self.law.revert()
+
+    def propose_multipliers(self, trial: np.ndarray) -> None:
+        """The multipliers the commit will make the committed ones (the converged tractions:
+        within the tolerance of those used, and the next increment starts from them)."""
+        if self.multipliers is None or np.shape(trial) != self.multipliers.shape:
+            raise ValueError(f"trial multipliers of shape {np.shape(trial)}; this history "
+                             f"holds {None if self.multipliers is None else self.multipliers.shape}")
+        self._multipliers_trial = trial
 
     def commit(self) -> None:
         """Accept the trial state (the global Newton converged and the enforcement is done)."""
@@ -176,7 +187,9 @@ class InterfaceHistory:
             self.multipliers_before = (self._multipliers_start
                                        if self._multipliers_start is not None
                                        else self.multipliers)
-        self._multipliers_start = None
+            if self._multipliers_trial is not None:
+                self.multipliers = self._multipliers_trial
+        self._multipliers_start = self._multipliers_trial = None
         self.law.commit()
 
     def revert(self) -> None:
@@ -184,6 +197,7 @@ class InterfaceHistory:
         if self._multipliers_start is not None:
             self.multipliers = self._multipliers_start
             self._multipliers_start = None
+        self._multipliers_trial = None
         self.law.revert()
 
     # ------------------------------------------------------------------ checkpoints
@@ -211,5 +225,5 @@ class InterfaceHistory:
                              "(multipliers present in one only)")
         self.multipliers = None if lam is None else np.array(lam)
         self.multipliers_before = None if before is None else np.array(before)
-        self._multipliers_start = None
+        self._multipliers_start = self._multipliers_trial = None
         self.pairing = state["pairing"]

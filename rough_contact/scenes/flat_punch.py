@@ -191,7 +191,7 @@ def build(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2, load_h
           law="rough", case="b", normal_law="elasto-plastic", steps=16, prefix="rc_",
           dof_threshold=None, quadrature_degree=None, normal=None, seating_steps=None,
           cell_type="tetrahedron", *, punch_scene=None, total_force=TOTAL_FORCE,
-          solver_defaults=None, quadrature="gauss", solver_options=None):
+          solver_defaults=None, quadrature="gauss", solver_options=None, enforcement=None):
     """Mesh, law, interface, problem and solver of the quarter punch. Collective.
 
     ``quadrature`` is the interface rule (``"gauss"`` of ``quadrature_degree``, default 2 x
@@ -208,7 +208,9 @@ def build(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2, load_h
     ``steps``) sets the seating pressure to the nominal pressure of 1/seating_steps of the load.
 
     ``law`` is "rough", "penalty" or any object satisfying the interface-law contract
-    (``rough_contact.interface.contract.InterfaceLawProtocol``), used as given.
+    (``rough_contact.interface.contract.InterfaceLawProtocol``), used as given;
+    ``enforcement`` (``rough_contact.interface.enforcement``: ``Penalty()``, the default, or
+    ``AugmentedLagrangian(...)``) is how the interface imposes it.
 
     Returns:
         :class:`PunchModel`.
@@ -238,7 +240,7 @@ def build(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2, load_h
     qdeg = quadrature_degree if quadrature_degree is not None else 2 * order
     interface = ContactInterface(V, scene.facet_tags, first, second, law=interface_law,
                                  grain_direction=(1.0, 0.0, 0.0), quadrature_degree=qdeg,
-                                 quadrature=quadrature, bcs=bcs)
+                                 quadrature=quadrature, bcs=bcs, enforcement=enforcement)
     materials = {scene.tag("punch"): Material(E, NU), scene.tag("foundation"): Material(E, NU)}
     loads = [SurfaceLoad(scene.tag("load"), force=[0.0, 0.0, -quarter_force])]
     problem = ContactProblem(V, materials, bcs, loads, cell_tags=scene.cell_tags,

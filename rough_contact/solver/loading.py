@@ -327,6 +327,7 @@ class _Stepper:
         sig = None if checkpoint is None else checkpoint_signature(problem)
         _check_initial_guess(problem)
         self.u_committed = problem.solution_vector().copy()
+        self.lam_committed = problem.load_factor
         start_index = 0
         if restored is not None:
             self.step, start_index = restored.step, restored.index

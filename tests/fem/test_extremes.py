@@ -301,7 +301,7 @@ class Scene:
                 assert inc.n_beyond_validity == n_below     # the load stepping's own count
                 out.max_below_validity = max(out.max_below_validity, n_below)
                 out.n_points = inc.n_points
-                sp_new = interface.slip_stats().max_plastic_slip
+                sp_new = interface.summary().max_plastic_slip
                 bound += case.mu * abs(inc.contact_force[2]) * (sp_new + sp_old)
                 sp_old = sp_new
                 if case.forced_failure and inc.step == 2:
