@@ -1,6 +1,6 @@
 """Grid convergence of the BEM normal law: p(h), k(h), A/A0(h) vs pixels per shortest wavelength.
 
-For each example surface (rough_contact.spectrum.example_surfaces) one Gaussian realisation is
+For each example surface (rough_contact.surface.spectrum.example_surfaces) one Gaussian realisation is
 generated on the finest grid and sub-sampled by 2, 4, ... (the same band-limited surface, coarser
 pixels). Each grid is solved at the same mean pressures (A/A0 about 1 % to 20 %); the laws are
 compared with the finest one at its separations (p, k, A/A0 at equal h) and at equal load
@@ -26,7 +26,7 @@ import warnings
 import numpy as np
 
 from rough_contact import bem
-from rough_contact.spectrum import _next_smooth, example_surfaces, fit_spectrum
+from rough_contact.surface.spectrum import _next_smooth, example_surfaces, fit_spectrum
 
 E_STAR = 1.067e5   # MPa: two steel bodies (E = 200 GPa, nu = 0.25), the paper's punch
 NU = 0.25

@@ -1023,7 +1023,7 @@ def bem_law_from_moments(moments: SpectralMoments, *, E_star: float, nu: float =
                          cache_dir: Optional[os.PathLike] = None) -> BEMLaw:
     """The BEM law of a surface known only by its spectral moments, with realisation scatter.
 
-    Gaussian realisations of the spectrum fitted by :func:`rough_contact.spectrum.fit_spectrum`
+    Gaussian realisations of the spectrum fitted by :func:`rough_contact.surface.spectrum.fit_spectrum`
     (the assumed shape is documented there: stretched isotropic self-affine with roll-off) are
     solved at the same pressures and averaged at equal separation (:func:`law_from_curves`).
 
@@ -1036,13 +1036,13 @@ def bem_law_from_moments(moments: SpectralMoments, *, E_star: float, nu: float =
         pixels_per_wavelength: pixels per shortest wavelength of the spectrum (grid study in
             docs/bem.md).
         periods: longest wavelengths per side of every realisation.
-        shape: :class:`rough_contact.spectrum.SpectrumShape` (default H = 0.8, plateau 2).
+        shape: :class:`rough_contact.surface.spectrum.SpectrumShape` (default H = 0.8, plateau 2).
         pressures: mean pressures [MPa]; default from the moments' rms slope over area_range.
 
     Returns:
         :class:`BEMLaw` whose ``*_std`` give the scatter between realisations.
     """
-    from rough_contact.spectrum import SpectrumShape, fit_spectrum
+    from rough_contact.surface.spectrum import SpectrumShape, fit_spectrum
 
     nr = int(check_scalar("n_realisations", n_realisations, lo=1.0, lo_open=False, hi=1e4))
     backend = _default_backend(backend, hardness)

@@ -43,7 +43,7 @@ import numpy as np
 from rough_contact import bem
 from rough_contact.asperity import AsperityMaterial
 from rough_contact.interface.normal import NormalLaw
-from rough_contact.spectrum import SpectrumShape, example_surfaces
+from rough_contact.surface.spectrum import SpectrumShape, example_surfaces
 from rough_contact.surface import SpectralMoments, moments_from_height_map
 
 E_STAR = 1.067e5     # MPa, two steel bodies E = 200 GPa, nu = 0.25 (the paper's punch)

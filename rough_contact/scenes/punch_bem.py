@@ -35,7 +35,7 @@ def build_laws(comm, surface, realisations, ppw, small, backend=None):
 
         from rough_contact import bem
         from rough_contact.interface.normal import NormalLaw
-        from rough_contact.spectrum import example_surfaces
+        from rough_contact.surface.spectrum import example_surfaces
 
         m, shape = example_surfaces()[surface]
         E_star = punch.effective_modulus(punch.E, punch.NU, punch.E, punch.NU)

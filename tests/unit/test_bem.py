@@ -20,7 +20,7 @@ from rough_contact import bem
 from rough_contact.bem import (BackendUnavailableError, HalfSpace, HeightMapWarning, NumpySolver,
                                _post_process)
 from rough_contact.interface.normal import NormalLaw
-from rough_contact.spectrum import SpectrumShape, fit_spectrum
+from rough_contact.surface.spectrum import SpectrumShape, fit_spectrum
 from rough_contact.surface import SpectralMoments, moments_from_height_map
 
 HAVE_TAMAAS = "tamaas" in bem.available_backends()
@@ -463,7 +463,7 @@ def test_spectrum_bad_input():
 
 
 def test_pure_layer():
-    code = ("import sys, rough_contact.bem, rough_contact.spectrum\n"
+    code = ("import sys, rough_contact.bem, rough_contact.surface.spectrum\n"
             "bad = {'dolfinx', 'ufl', 'petsc4py', 'basix', 'mpi4py', 'gmsh', 'tamaas'} & "
             "set(sys.modules)\n"
             "assert not bad, bad\n")

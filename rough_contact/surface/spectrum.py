@@ -45,8 +45,8 @@ from typing import Tuple
 import numpy as np
 from scipy.optimize import brentq
 
-from rough_contact.surface import SpectralMoments
-from rough_contact.validation import check_scalar
+from .moments import SpectralMoments
+from ..validation import check_scalar
 
 __all__ = ["SpectrumShape", "StretchedSpectrum", "fit_spectrum", "example_surfaces"]
 
