@@ -10,7 +10,7 @@ compared with the finest one at its separations (p, k, A/A0 at equal h) and at e
     bash run.sh python benchmarks/bench_bem_convergence.py --full          # ppw up to 16/32
     bash run.sh python benchmarks/bench_bem_convergence.py --surfaces paper --ppw 2 4 8
 
-Results are cached on disk (rough_contact.bem.default_cache_dir()); --no-cache recomputes.
+Results are cached on disk (rough_contact.micro.bem.default_cache_dir()); --no-cache recomputes.
 Units: mm, MPa; ppw = pixels per shortest wavelength 2 pi/q_s of the spectrum.
 """
 from __future__ import annotations
@@ -25,7 +25,7 @@ import warnings
 
 import numpy as np
 
-from rough_contact import bem
+from rough_contact.micro import bem
 from rough_contact.surface.spectrum import _next_smooth, example_surfaces, fit_spectrum
 
 E_STAR = 1.067e5   # MPa: two steel bodies (E = 200 GPa, nu = 0.25), the paper's punch

@@ -18,8 +18,8 @@ import warnings
 
 import numpy as np
 
-from rough_contact import bem
-from rough_contact.asperity import AsperityMaterial
+from rough_contact.micro import bem
+from rough_contact.micro.asperity import AsperityMaterial
 from rough_contact.interface.normal import NormalLaw
 from rough_contact.surface.spectrum import example_surfaces, fit_spectrum
 

@@ -1,7 +1,7 @@
 """Gaussian rough surfaces with a prescribed spectrum, fitted to five spectral moments.
 
 A user who has only the spectral moments m00, m20, m02, m40, m04 of a surface (the statistical
-law's input) gets height maps for the boundary-element law (:mod:`rough_contact.bem`) from here.
+law's input) gets height maps for the boundary-element law (:mod:`rough_contact.micro.bem`) from here.
 Five moments do not determine a spectrum; this module **assumes** the following shape and says
 so wherever it is used.
 
