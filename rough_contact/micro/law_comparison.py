@@ -17,11 +17,9 @@ import warnings
 
 import numpy as np
 
-from rough_contact.micro import bem
-from rough_contact.micro.asperity import AsperityMaterial
-from rough_contact.interface.normal import NormalLaw
-from rough_contact.surface.spectrum import SpectrumShape, example_surfaces
-from rough_contact.surface import SpectralMoments, moments_from_height_map
+from . import bem
+from .asperity import AsperityMaterial
+from ..surface import SpectralMoments, SpectrumShape, example_surfaces, moments_from_height_map
 
 E_STAR = 1.067e5     # MPa, two steel bodies E = 200 GPa, nu = 0.25 (the paper's punch)
 NU = 0.25
@@ -35,6 +33,10 @@ AGREE = ("k_at_p", "a_at_p", "p_at_h")
 def statistical_laws(moments: SpectralMoments, E_star: float, material: AsperityMaterial,
                      plastic: bool = True):
     """The package's statistical laws of the surface: dict name -> NormalLaw."""
+    # the laws are the interface layer's NormalLaw (the layer above micro/): imported here so
+    # that importing rough_contact.micro never loads rough_contact.interface
+    from rough_contact.interface.normal import NormalLaw
+
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)   # isotropic surfaces: reported in the text
         out = {STAT[0]: NormalLaw.elastic(moments, E_star),
