@@ -134,7 +134,7 @@ def normal_law(comm, example, kind, rtol):
         t0 = time.perf_counter()
         law = None
         if comm.rank == 0:
-            from rough_contact.asperity import AsperityMaterial
+            from rough_contact.micro.asperity import AsperityMaterial
             from rough_contact.interface.normal import NormalLaw
             from rough_contact.surface import SpectralMoments
 

@@ -86,7 +86,7 @@ def make_normal_law(comm, m00, normal_law, hardness="psi"):
         if normal_law == "elastic":
             normal = NormalLaw.elastic(surface, E_STAR)
         else:
-            from rough_contact.asperity import AsperityMaterial
+            from rough_contact.micro.asperity import AsperityMaterial
 
             data = dict(PLASTIC)
             if hardness == "tabor":

@@ -95,7 +95,7 @@ def make_law(comm, law="rough", case="b", normal_law="elastic", seating_pressure
                          "'elastic', 'elasto-plastic'")
     if normal is None:
         if comm.rank == 0:  # the table is built once and copied to the other ranks
-            from rough_contact.asperity import AsperityMaterial
+            from rough_contact.micro.asperity import AsperityMaterial
             from rough_contact.interface.normal import NormalLaw
             from rough_contact.surface import SpectralMoments
 

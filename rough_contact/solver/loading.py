@@ -503,7 +503,7 @@ def _validity_guard(inc: Increment, policy: str) -> None:
            "value, i.e. real-area fraction above the model's limit, where a stiff continuation "
            "replaces the rough-surface model); pressures and stiffnesses there are not the "
            "model's. Lower the load, or use a law valid at higher load (e.g. the BEM-calibrated "
-           "law, rough_contact.bem)")
+           "law, rough_contact.micro.bem)")
     if policy == "error":
         raise ModelValidityError(msg + "; this increment is committed", inc.load_factor,
                                  inc.n_beyond_validity, inc.n_points)

@@ -212,7 +212,7 @@ class Scene:
                     if psi is None:
                         normal = NormalLaw.elastic(surface, E_star, rtol=NORMAL_RTOL)
                     else:
-                        from rough_contact.asperity import AsperityMaterial
+                        from rough_contact.micro.asperity import AsperityMaterial
 
                         mat = AsperityMaterial(E_star=E_star, nu=demo.NU,
                                                **dict(demo.PLASTIC, psi=psi))

@@ -179,7 +179,7 @@ def test_friction_evaluate_matches_return_map_and_writes_in_place(friction, kt_y
     dkt = -kt * 1e3
     p, kn = rng.uniform(0.1, 5.0, m), rng.uniform(1e3, 1e5, m)
     kap, path = rng.uniform(0, 1e-3, (m, 2)), rng.uniform(0, 1e-3, m)
-    ref = friction.return_map(e, kt, dkt, p, kn, kap, path)
+    ref = friction.evaluate(FrictionInput.from_pairs(e, kt, dkt, p, kn, kap, path))
     pts = FrictionInput(e[:, 0].copy(), e[:, 1].copy(), kt[:, 0].copy(), kt[:, 1].copy(),
                         dkt[:, 0].copy(), dkt[:, 1].copy(), p, kn, kap[:, 0].copy(),
                         kap[:, 1].copy(), path)

@@ -8,8 +8,10 @@ import sys
 import rough_contact
 import rough_contact.interface
 
-PURE = ["rough_contact.surface", "rough_contact.asperity", "rough_contact.population",
-        "rough_contact.validation", "rough_contact.topography"] + [
+PURE = ["rough_contact.surface", "rough_contact.surface.moments", "rough_contact.surface.spectrum",
+        "rough_contact.surface.topography", "rough_contact.micro.asperity",
+        "rough_contact.micro.population", "rough_contact.micro.tables", "rough_contact.micro.bem",
+        "rough_contact.micro.law_comparison", "rough_contact.validation"] + [
     f"rough_contact.interface.{m.name}" for m in pkgutil.iter_modules(rough_contact.interface.__path__)
 ]
 

@@ -337,11 +337,11 @@ def test_from_model_validation():
 
 
 # ----------------------------------------------------------------------------------------------
-# population models of helper A (rough_contact.population)
+# population models of helper A (rough_contact.micro.population)
 # ----------------------------------------------------------------------------------------------
-_HAVE_POPULATION = importlib.util.find_spec("rough_contact.population") is not None
+_HAVE_POPULATION = importlib.util.find_spec("rough_contact.micro.population") is not None
 needs_population = pytest.mark.skipif(not _HAVE_POPULATION,
-                                      reason="rough_contact.population not written yet")
+                                      reason="rough_contact.micro.population not written yet")
 
 
 def _check_against_population(law, direct, rtol, n=40):
@@ -361,7 +361,7 @@ def _check_against_population(law, direct, rtol, n=40):
 
 @needs_population
 def test_population_greenwood_williamson():
-    from rough_contact import population
+    from rough_contact.micro import population
     from rough_contact.surface import SpectralMoments
 
     surface = SpectralMoments(M00, M20, M02, M40, M04, unit="um")
@@ -375,7 +375,7 @@ def test_population_greenwood_williamson():
 
 @needs_population
 def test_population_elastic():
-    from rough_contact import population
+    from rough_contact.micro import population
     from rough_contact.surface import SpectralMoments
 
     surface = SpectralMoments(M00, M20, M02, M40, M04, unit="um")
@@ -386,8 +386,8 @@ def test_population_elastic():
 
 @needs_population
 def test_population_elasto_plastic():
-    from rough_contact import population
-    from rough_contact.asperity import AsperityMaterial
+    from rough_contact.micro import population
+    from rough_contact.micro.asperity import AsperityMaterial
     from rough_contact.surface import SpectralMoments
 
     surface = SpectralMoments(M00, M20, M02, M40, M04, unit="um")
@@ -536,7 +536,7 @@ def test_nearly_degenerate_elasto_plastic_build_ends_with_a_clear_error():
     minutes. Here a coarse population quadrature (n_quad = 12, ~8x cheaper) and the knot budget
     keep the test at ~3 CPU s; with the defaults the build ends by itself, model-limited, after
     47 knots (16 CPU s, 28 s wall on the loaded 2-core machine; issue 12's report)."""
-    from rough_contact.asperity import AsperityMaterial
+    from rough_contact.micro.asperity import AsperityMaterial
     from rough_contact.surface import SpectralMoments
 
     surface = SpectralMoments(0.2 * M00, M20, M02, M40, M04, unit="um")
