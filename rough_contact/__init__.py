@@ -7,7 +7,8 @@ Layers (each imports only those above it in this list):
     validation                        check_scalar, the one input check of every layer
     surface, asperity, population     pure numpy/scipy rough-surface micro-model
     interface                         pure numpy interface laws at quadrature points
-    fem, solver                       DOLFINx / PETSc (the only packages importing them)
+    fem, solver                       DOLFINx / PETSc (the only packages importing them, with io)
+    io                                results on disk (XDMF, CSV, atomic writes) and plots
 
 Internal unit system: mm, N, MPa (N/mm^2), so stiffnesses per area are in MPa/mm = N/mm^3.
 Spectral moments are given in the paper's micrometre convention at the API boundary
