@@ -17,11 +17,11 @@ import importlib
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:  # the same names as _SOURCES, spelled as imports for readers and checkers
-    from .files import (RUN_OUTPUT_PATTERNS, OutputExistsError, atomic_write, atomic_write_text,
-                        prepare_output_dir)
-    from .interface_output import (InterfaceResults, InterfaceWriter, pseudo_time,
-                                   read_interface_results)
-    from .results import CsvRecorder, ResultWriter, gather_points
+    from .files import (RUN_OUTPUT_PATTERNS, OutputExistsError, atomic_write,  # noqa: F401
+                        atomic_write_text, prepare_output_dir)
+    from .interface_output import (InterfaceResults, InterfaceWriter,  # noqa: F401
+                                   pseudo_time, read_interface_results)
+    from .results import CsvRecorder, ResultWriter, gather_points  # noqa: F401
 
 # public name -> module of this package that defines it
 _SOURCES = {
