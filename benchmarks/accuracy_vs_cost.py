@@ -78,10 +78,10 @@ from petsc4py import PETSc  # noqa: E402
 from dolfinx import fem  # noqa: E402
 
 
+from rough_contact.io import gather_points  # noqa: E402
 from rough_contact.scenes import beam as beam_demo  # noqa: E402
 from rough_contact.scenes import flat_punch as punch_demo  # noqa: E402
 from rough_contact.solver.loading import load_path, load_unload_factors  # noqa: E402
-from rough_contact.solver.output import gather_points  # noqa: E402
 
 logging.getLogger().addFilter(lambda record: record.levelno >= logging.WARNING)
 

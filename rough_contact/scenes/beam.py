@@ -26,9 +26,9 @@ from rough_contact.fem.contact import ContactInterface
 from rough_contact.fem.mesh import Scene
 from rough_contact.fem.problem import ContactProblem, Material, SurfaceLoad
 from rough_contact.interface.law import InterfaceLaw
+from rough_contact.io import ResultWriter, atomic_write_text, gather_points
 from rough_contact.scenes.meshes.beam import beam_on_base
 from rough_contact.solver.loading import load_path
-from rough_contact.solver.output import ResultWriter, atomic_write_text, gather_points
 from rough_contact.solver.snes import SNESSolver
 from rough_contact.validation import check_scalar
 

@@ -33,9 +33,9 @@ from rough_contact.fem.contact import ContactInterface
 from rough_contact.fem.mesh import Scene
 from rough_contact.fem.problem import ContactProblem, Material, SurfaceLoad
 from rough_contact.interface.contract import InterfaceLawProtocol
+from rough_contact.io import ResultWriter, gather_points
 from rough_contact.scenes.meshes.flat_punch import flat_punch
 from rough_contact.solver.loading import load_path, load_unload_factors
-from rough_contact.solver.output import ResultWriter, gather_points
 from rough_contact.solver.snes import SNESSolver
 from rough_contact.validation import check_scalar
 
@@ -276,8 +276,8 @@ def point_data(interface):
 
 def plot_slip_directions(comm, interface, path, title, n_grid=12):
     """Quiver of the plastic slip directions at contact points (Figs 18-19), about n_grid^2
-    arrows, drawn by :func:`rough_contact.plotting.plot_slip_quiver`. Collective."""
-    from rough_contact import plotting
+    arrows, drawn by :func:`rough_contact.io.plotting.plot_slip_quiver`. Collective."""
+    from rough_contact.io import plotting
 
     pts, fields = gather_points(comm, *point_data(interface))
     if comm.rank != 0:

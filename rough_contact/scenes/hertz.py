@@ -26,9 +26,9 @@ from rough_contact.fem.contact import ContactInterface
 from rough_contact.fem.problem import ContactProblem, Material, PrescribedDisplacement
 from rough_contact.fem.rigid import RigidSphere
 from rough_contact.interface.penalty import LinearPenalty
+from rough_contact.io import gather_points
 from rough_contact.scenes.meshes.blocks import indented_block
 from rough_contact.solver.loading import load_path
-from rough_contact.solver.output import gather_points
 from rough_contact.solver.snes import SNESSolver
 
 __all__ = ["run", "run_elastic"]

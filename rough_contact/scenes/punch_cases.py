@@ -15,9 +15,9 @@ from __future__ import annotations
 import numpy as np
 from mpi4py import MPI
 
+from rough_contact.io import gather_points
 from rough_contact.scenes import flat_punch as demo
 from rough_contact.solver.loading import load_path, load_unload_factors
-from rough_contact.solver.output import gather_points
 
 FLIP = np.array([1.0, -1.0])  # local (x, y) -> global (x, y): y_local = n x x = -y_global
 
@@ -132,13 +132,13 @@ def run_case(case, comm=MPI.COMM_WORLD, mesh_size=10.0, contact_size=1.0, order=
     return res
 
 
-# ## Figures (rank 0), drawn with rough_contact.plotting
+# ## Figures (rank 0), drawn with rough_contact.io.plotting
 def plot_case(res, path):
     """Three panels: plastic slip directions at peak, after unloading; stick/slip at peak."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    from rough_contact import plotting
+    from rough_contact.io import plotting
 
     fig = Figure(figsize=(15, 4.8))
     FigureCanvasAgg(fig)

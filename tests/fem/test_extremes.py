@@ -40,8 +40,8 @@ from rough_contact.scenes import flat_punch as demo  # noqa: E402
 from petsc4py import PETSc  # noqa: E402
 
 from rough_contact.interface.contract import ConvergenceError  # noqa: E402
+from rough_contact.io import ResultWriter  # noqa: E402
 from rough_contact.solver.loading import LoadStepError, load_path, load_unload_factors  # noqa: E402
-from rough_contact.solver.output import ResultWriter  # noqa: E402
 
 # Coarse scene: ~1 s per Newton solve sequence on one core.
 MESH = dict(mesh_size=20.0, contact_size=2.5, order=1, load_half_width=2.5)

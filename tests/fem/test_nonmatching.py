@@ -27,9 +27,9 @@ from petsc4py import PETSc
 import dolfinx
 from dolfinx import fem
 from rough_contact.fem.contact import ContactInterface
-from rough_contact.fem.interface_output import facet_output
 from rough_contact.fem.problem import ContactProblem, Material, SurfaceLoad
 from rough_contact.interface.penalty import LinearPenalty, SoftplusPenalty
+from rough_contact.io.interface_output import facet_output
 from rough_contact.scenes.meshes.blocks import separate_blocks
 from rough_contact.solver.snes import SNESSolver
 

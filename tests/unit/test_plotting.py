@@ -1,4 +1,4 @@
-"""rough_contact.plotting: PNGs from tiny data, loop energies against an analytic loop."""
+"""rough_contact.io.plotting: PNGs from tiny data, loop energies against an analytic loop."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import sys
 import numpy as np
 import pytest
 
-from rough_contact import plotting
+from rough_contact.io import plotting
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 
@@ -24,7 +24,7 @@ def assert_png(path):
 
 
 def test_import_needs_neither_matplotlib_nor_fe_stack():
-    code = ("import sys, rough_contact.plotting\n"
+    code = ("import sys, rough_contact.io.plotting\n"
             "bad = {'matplotlib', 'dolfinx', 'ufl', 'petsc4py', 'basix', 'mpi4py', 'gmsh'}"
             " & set(sys.modules)\n"
             "assert not bad, bad\n")
