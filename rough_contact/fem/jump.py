@@ -232,7 +232,7 @@ class JumpOperator:
         matrix has dolfinx's layout and local-to-global map, so dolfinx assembles into it."""
         comm = self.comm
         imap = self.V.dofmap.index_map
-        n_loc, r0, n_glob = imap.size_local, imap.local_range[0], imap.size_global
+        r0, n_glob = imap.local_range[0], imap.size_global
         bulk_rows, bulk_cols = compat.form_sparsity(a, self.V)
         rows, cols = self.sparsity_blocks()
         key = np.unique(rows.ravel() * n_glob + cols.ravel())

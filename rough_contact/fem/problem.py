@@ -258,6 +258,21 @@ class ContactProblem:
         if self._prescribed and interface is not None:
             interface.set_dirichlet_dofs(bcs=self.bcs)
 
+        self._bulk_form(materials, cell_tags, facet_tags, quadrature_degree)
+        self._load_vectors(facet_tags)
+        self._matrices()
+        self._seating(seating_tag, seating_stiffness)
+        # Initial iterate satisfies the Dirichlet values.
+        fem.set_bc(self.u.x.array, self.bcs)
+        self.u.x.scatter_forward()
+        self.b = self.f.duplicate()
+        self.counters = {"residual": 0, "jacobian": 0}
+        self.timings = {"bulk": 0.0, "interface_residual": 0.0, "interface_jacobian": 0.0}
+
+    # ------------------------------------------------------------------ set-up steps
+    def _bulk_form(self, materials, cell_tags, facet_tags, quadrature_degree) -> None:
+        """The bilinear form of linear elasticity, per body; the measures."""
+        msh, V = self.mesh, self.V
         if isinstance(materials, Material):
             materials = {None: materials}
         elif not materials:
@@ -274,6 +289,8 @@ class ContactProblem:
         def eps(w):
             return ufl.sym(ufl.grad(w))
 
+        self._ds = ds
+        self._u_trial = u
         a = 0
         for tag, mat in self.materials.items():
             lmbda, mu = mat.lame
@@ -283,8 +300,10 @@ class ContactProblem:
         self.a = fem.form(a)
         self._a_ufl, self._v = a, v
 
-        # External load vectors at scale 1, one per channel; tractions from total forces use the
-        # surface area.
+    def _load_vectors(self, facet_tags) -> None:
+        """External load vectors at scale 1, one per channel (tractions from total forces use
+        the surface area)."""
+        msh, v, ds = self.mesh, self._v, self._ds
         self.applied_force = np.zeros(3)          # all channels at scale 1
         self._channel_force = {}
         L, L_channel = 0, {}
@@ -310,8 +329,12 @@ class ContactProblem:
         if L == 0:
             L = ufl.inner(fem.Constant(msh, np.zeros(3)), v) * ufl.dx(domain=msh)
         self.L = fem.form(L)
+        self._L_channel = L_channel
 
-        # Bulk stiffness, once, into a matrix with room for the interface blocks.
+    def _matrices(self) -> None:
+        """Bulk stiffness, once, into a matrix with room for the interface blocks; the load
+        vectors with and without the constrained rows; the lifting."""
+        interface = self.interface
         t0 = MPI.Wtime()
         if interface is not None:
             self.K = interface.create_matrix(self.a)
@@ -327,7 +350,7 @@ class ContactProblem:
         self.f.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
         # per channel, with the constrained rows (for reactions) and without (for the residual)
         self._f_channel = {}
-        for name, form in L_channel.items():
+        for name, form in self._L_channel.items():
             full = fem_petsc.assemble_vector(fem.form(form))
             full.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
             free = full.copy()
@@ -338,24 +361,19 @@ class ContactProblem:
         self.update_dirichlet()
         self.f_norm = self.f.norm()
 
+    def _seating(self, seating_tag, seating_stiffness) -> None:
+        """The Jacobian-only spring on the seating surface (see the class)."""
         self.seating_stiffness = check_scalar("seating_stiffness", seating_stiffness, lo=0.0,
                                               lo_open=False, unit="MPa/mm")
         self.M_seat = None
         self._seat_form = None
         if seating_tag is not None and self.seating_stiffness > 0.0:
-            k_seat = fem.Constant(msh, self.seating_stiffness)
-            m = fem.form(k_seat * ufl.inner(u, v) * ds(seating_tag))
+            k_seat = fem.Constant(self.mesh, self.seating_stiffness)
+            m = fem.form(k_seat * ufl.inner(self._u_trial, self._v) * self._ds(seating_tag))
             # On the pattern of K (a superset), so it can be added with SAME_NONZERO_PATTERN.
             self._seat_form = m
             self._assemble_seating()
         self.seating_active = False
-
-        # Initial iterate satisfies the Dirichlet values.
-        fem.set_bc(self.u.x.array, self.bcs)
-        self.u.x.scatter_forward()
-        self.b = self.f.duplicate()
-        self.counters = {"residual": 0, "jacobian": 0}
-        self.timings = {"bulk": 0.0, "interface_residual": 0.0, "interface_jacobian": 0.0}
 
     # ------------------------------------------------------------------ PETSc callbacks
     def update_solution(self, x: PETSc.Vec) -> None:

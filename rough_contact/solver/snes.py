@@ -135,6 +135,32 @@ def _reason_name(reason: int) -> str:
     return str(reason)
 
 
+def _choose_linear_solver(cmd, prefix: str, n: int, dof_threshold: Optional[int],
+                          linear_solver: str) -> tuple[int, str]:
+    """(the DOF threshold, the option set's name): the command line's ``-PREFIXdof_threshold``
+    and ``-PREFIXlinear_solver`` override the arguments; ``"auto"`` takes the set of a given
+    ``-PREFIXpc_type``, else MUMPS up to the threshold and algebraic multigrid above it."""
+    if cmd.hasName(prefix + "dof_threshold"):
+        dof_threshold = cmd.getInt(prefix + "dof_threshold")
+    if dof_threshold is None:
+        dof_threshold = DEFAULT_DOF_THRESHOLD
+    check_scalar("dof_threshold", dof_threshold, lo=0, lo_open=False)
+    if cmd.hasName(prefix + "linear_solver"):
+        linear_solver = cmd.getString(prefix + "linear_solver")
+    if linear_solver != "auto" and linear_solver not in LINEAR_SOLVERS:
+        raise ValueError(f"linear solver = {linear_solver!r} is invalid; valid values: "
+                         f"'auto', {', '.join(repr(k) for k in LINEAR_SOLVERS)}")
+    if linear_solver == "auto":
+        pc_user = (cmd.getString(prefix + "pc_type") if cmd.hasName(prefix + "pc_type")
+                   else None)
+        if pc_user is not None:
+            linear_solver = {"lu": "mumps", "cholesky": "mumps", "gamg": "gamg",
+                             "hypre": "hypre"}.get(pc_user, "krylov")
+        else:
+            linear_solver = "mumps" if n <= int(dof_threshold) else AMG_DEFAULT
+    return int(dof_threshold), linear_solver
+
+
 class SNESSolver:
     """Newton solver on a :class:`~rough_contact.fem.problem.ContactProblem`.
 
@@ -182,27 +208,9 @@ class SNESSolver:
         self.problem = problem
         self.prefix = prefix
         comm = problem.comm
-        n = problem.num_dofs
         cmd = PETSc.Options()
-        if cmd.hasName(prefix + "dof_threshold"):
-            dof_threshold = cmd.getInt(prefix + "dof_threshold")
-        if dof_threshold is None:
-            dof_threshold = DEFAULT_DOF_THRESHOLD
-        check_scalar("dof_threshold", dof_threshold, lo=0, lo_open=False)
-        self.dof_threshold = int(dof_threshold)
-        if cmd.hasName(prefix + "linear_solver"):
-            linear_solver = cmd.getString(prefix + "linear_solver")
-        if linear_solver != "auto" and linear_solver not in LINEAR_SOLVERS:
-            raise ValueError(f"linear solver = {linear_solver!r} is invalid; valid values: "
-                             f"'auto', {', '.join(repr(k) for k in LINEAR_SOLVERS)}")
-        if linear_solver == "auto":
-            pc_user = (cmd.getString(prefix + "pc_type") if cmd.hasName(prefix + "pc_type")
-                       else None)
-            if pc_user is not None:
-                linear_solver = {"lu": "mumps", "cholesky": "mumps", "gamg": "gamg",
-                                 "hypre": "hypre"}.get(pc_user, "krylov")
-            else:
-                linear_solver = "mumps" if n <= self.dof_threshold else AMG_DEFAULT
+        self.dof_threshold, linear_solver = _choose_linear_solver(
+            cmd, prefix, problem.num_dofs, dof_threshold, linear_solver)
         self.option_set = linear_solver
         if cmd.hasName(prefix + "near_nullspace"):
             near_nullspace = cmd.getString(prefix + "near_nullspace")
@@ -242,6 +250,13 @@ class SNESSolver:
             self.snes.setFromOptions()
         self._atol0 = self.snes.getTolerances()[1]
         self._k_norm_inf = problem.K.norm(PETSc.NormType.INFINITY)
+        self._set_near_nullspace(near_nullspace)
+        self._residuals: list = []
+        self.snes.setMonitor(self._monitor)
+
+    def _set_near_nullspace(self, near_nullspace) -> None:
+        """Rigid-body modes for the algebraic multigrid preconditioners (else none)."""
+        problem = self.problem
         pc_type = self.snes.getKSP().getPC().getType()
         if pc_type in ("gamg", "hypre", "ml") or not isinstance(near_nullspace, str):
             if near_nullspace == "global":
@@ -253,8 +268,6 @@ class SNESSolver:
             self.near_nullspace = near_nullspace
         else:
             self.near_nullspace = None
-        self._residuals: list = []
-        self.snes.setMonitor(self._monitor)
 
     def _options(self):
         """The solver's defaults in the database (where absent) for the duration of a block."""

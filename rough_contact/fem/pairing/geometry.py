@@ -353,20 +353,7 @@ def mortar_points(first: SecondSurface, first_vertices: np.ndarray, second: Seco
     cyc = cyclic_order(nv)
     P1 = first_vertices[:, cyc]
     P2 = second_vertices[:, cyc]
-    c1 = P1.mean(axis=1)
-    c2 = P2.mean(axis=1)
-    r1 = np.linalg.norm(P1 - c1[:, None], axis=2).max(axis=1)
-    r2 = np.linalg.norm(P2 - c2[:, None], axis=2).max(axis=1)
-    # candidate pairs: centroid distance <= r1 + max r2 (then filtered by r1 + r2)
-    tree = cKDTree(c2)
-    counts = tree.query_ball_point(c1, r1 + r2.max(), return_length=True)
-    k = int(min(max(int(np.max(counts)), 1), second.size))
-    dist, cand = tree.query(c1, k=k)
-    dist, cand = np.asarray(dist).reshape(n1, k), np.asarray(cand).reshape(n1, k)
-    ok = (cand < second.size)
-    ok[ok] &= dist[ok] <= (r1[:, None] + r2[np.where(ok, cand, 0)])[ok] * (1 + 1e-12)
-    i1, j = np.nonzero(ok)
-    i2 = cand[i1, j]
+    i1, i2 = _overlap_candidates(P1, P2)
     # frames on the first facets' planes
     e1 = P1[:, 1] - P1[:, 0]
     e1 /= np.linalg.norm(e1, axis=1)[:, None]
@@ -388,12 +375,40 @@ def mortar_points(first: SecondSurface, first_vertices: np.ndarray, second: Seco
                          - np.roll(subj[:, :, 0], -1, axis=1) * subj[:, :, 1], axis=1)
     subj = np.where((area2 < 0)[:, None, None], subj[:, ::-1], subj)
     poly, n = clip_convex(subj, np.full(i1.size, nv), clip)
-    # fan triangulation from vertex 0, rule points on every triangle
-    V = poly.shape[1]
     # facet areas (triangles; parallelograms for the flat quadrilaterals this rule assumes)
     area1 = np.linalg.norm(np.cross(P1[:, 1] - P1[:, 0], P1[:, -1] - P1[:, 0]), axis=1)
     if nv == 3:
         area1 *= 0.5
+    return _fan_points(poly, n, i1, i2, (origin, e1, e2), area1, rule_points, rule_weights,
+                       min_fraction, empty)
+
+
+def _overlap_candidates(P1: np.ndarray, P2: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(i1, i2): pairs of first and second facets (cyclic vertices P1, P2) whose centroids are
+    closer than the sum of their radii: the only ones that can overlap."""
+    n1, n2 = P1.shape[0], P2.shape[0]
+    c1 = P1.mean(axis=1)
+    c2 = P2.mean(axis=1)
+    r1 = np.linalg.norm(P1 - c1[:, None], axis=2).max(axis=1)
+    r2 = np.linalg.norm(P2 - c2[:, None], axis=2).max(axis=1)
+    # candidate pairs: centroid distance <= r1 + max r2 (then filtered by r1 + r2)
+    tree = cKDTree(c2)
+    counts = tree.query_ball_point(c1, r1 + r2.max(), return_length=True)
+    k = int(min(max(int(np.max(counts)), 1), n2))
+    dist, cand = tree.query(c1, k=k)
+    dist, cand = np.asarray(dist).reshape(n1, k), np.asarray(cand).reshape(n1, k)
+    ok = (cand < n2)
+    ok[ok] &= dist[ok] <= (r1[:, None] + r2[np.where(ok, cand, 0)])[ok] * (1 + 1e-12)
+    i1, j = np.nonzero(ok)
+    return i1, cand[i1, j]
+
+
+def _fan_points(poly, n, i1, i2, frame, area1, rule_points, rule_weights, min_fraction,
+                empty) -> MortarPoints:
+    """Fan triangulation of the clipped polygons (2D, in the first facets' frames) from vertex
+    0, the triangle rule on every triangle, mapped back to 3D."""
+    origin, e1, e2 = frame
+    V = poly.shape[1]
     xs, ws, f1s, f2s = [], [], [], []
     for t in range(1, V - 1):       # at most 6 triangles: a loop over fan positions only
         has = n > t + 1
