@@ -37,6 +37,7 @@ import argparse
 import json
 import os
 import time
+from dataclasses import asdict, replace
 
 from mpi4py import MPI
 
@@ -81,7 +82,8 @@ def main(argv=None, comm=MPI.COMM_WORLD):
         plot_unloading(results, os.path.join(args.figdir, "punch_unloading.png"))
         table = summary_table(results)
         print(table)
-        keep = [{k: v for k, v in r.items() if k not in ("peak", "end")} for r in results]
+        keep = [{k: v for k, v in asdict(replace(r, peak=None, end=None)).items()
+                 if k not in ("peak", "end")} for r in results]
         with open(os.path.join(args.outdir, "punch_cases.json"), "w") as fh:
             json.dump(dict(args=vars(args), ranks=comm.size, results=keep), fh, indent=1)
         print(f"total wall time {time.perf_counter() - t0:.1f} s on {comm.size} rank(s)")

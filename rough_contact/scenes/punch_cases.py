@@ -297,7 +297,7 @@ def summary_table(results):
              "| slip sign kept (reversed area) | DOFs / points | wall [s] |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in results:
-        c = r["case"]
+        c = r.case
         lines.append(
             f"| ({c}) | {r.D_peak:.3e} | {r.D_end:.3e} | {r.D_literal_peak:.3e} | "
             f"{4 * r.D_end:.3e} | {demo.TABLE5['21-node'][c]} | {demo.TABLE5['28-node'][c]} | "
