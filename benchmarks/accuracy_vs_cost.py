@@ -78,10 +78,10 @@ from petsc4py import PETSc  # noqa: E402
 from dolfinx import fem  # noqa: E402
 
 
+from rough_contact.io import gather_points  # noqa: E402
 from rough_contact.scenes import beam as beam_demo  # noqa: E402
 from rough_contact.scenes import flat_punch as punch_demo  # noqa: E402
 from rough_contact.solver.loading import load_path, load_unload_factors  # noqa: E402
-from rough_contact.solver.output import gather_points  # noqa: E402
 
 logging.getLogger().addFilter(lambda record: record.levelno >= logging.WARNING)
 
@@ -134,7 +134,7 @@ def normal_law(comm, example, kind, rtol):
         t0 = time.perf_counter()
         law = None
         if comm.rank == 0:
-            from rough_contact.asperity import AsperityMaterial
+            from rough_contact.micro.asperity import AsperityMaterial
             from rough_contact.interface.normal import NormalLaw
             from rough_contact.surface import SpectralMoments
 

@@ -17,8 +17,8 @@ import warnings
 
 import numpy as np
 
-from rough_contact import bem
-from rough_contact.bem import HalfSpace, NumpySolver, _post_process
+from rough_contact.micro import bem
+from rough_contact.micro.bem import HalfSpace, NumpySolver, _post_process
 
 E_STAR, NU, AMP, LAM = 1000.0, 0.3, 0.002, 1.0
 

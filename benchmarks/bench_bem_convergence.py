@@ -1,6 +1,6 @@
 """Grid convergence of the BEM normal law: p(h), k(h), A/A0(h) vs pixels per shortest wavelength.
 
-For each example surface (rough_contact.spectrum.example_surfaces) one Gaussian realisation is
+For each example surface (rough_contact.surface.spectrum.example_surfaces) one Gaussian realisation is
 generated on the finest grid and sub-sampled by 2, 4, ... (the same band-limited surface, coarser
 pixels). Each grid is solved at the same mean pressures (A/A0 about 1 % to 20 %); the laws are
 compared with the finest one at its separations (p, k, A/A0 at equal h) and at equal load
@@ -10,7 +10,7 @@ compared with the finest one at its separations (p, k, A/A0 at equal h) and at e
     bash run.sh python benchmarks/bench_bem_convergence.py --full          # ppw up to 16/32
     bash run.sh python benchmarks/bench_bem_convergence.py --surfaces paper --ppw 2 4 8
 
-Results are cached on disk (rough_contact.bem.default_cache_dir()); --no-cache recomputes.
+Results are cached on disk (rough_contact.micro.bem.default_cache_dir()); --no-cache recomputes.
 Units: mm, MPa; ppw = pixels per shortest wavelength 2 pi/q_s of the spectrum.
 """
 from __future__ import annotations
@@ -25,8 +25,8 @@ import warnings
 
 import numpy as np
 
-from rough_contact import bem
-from rough_contact.spectrum import _next_smooth, example_surfaces, fit_spectrum
+from rough_contact.micro import bem
+from rough_contact.surface.spectrum import _next_smooth, example_surfaces, fit_spectrum
 
 E_STAR = 1.067e5   # MPa: two steel bodies (E = 200 GPa, nu = 0.25), the paper's punch
 NU = 0.25

@@ -4,7 +4,7 @@ and the evaluation cost of the resulting tables (what the FE layer pays per quad
     bash run.sh python benchmarks/bench_bem_cost.py                # ~3 min
     bash run.sh python benchmarks/bench_bem_cost.py --grids 64 128 256 512 1024 --pressures 16
 
-Build: one realisation of the isotropic example surface (rough_contact.spectrum) on n x n pixels
+Build: one realisation of the isotropic example surface (rough_contact.surface.spectrum) on n x n pixels
 over one roll-off period, solved at ``--pressures`` mean pressures (A/A0 ~ 0.5 % to 30 %), with
 and without the tangential stiffness; no disk cache. Evaluation: NormalLaw.evaluate on 1e6
 random separations inside the table, best of 5. Units: s, M points/s.
@@ -18,10 +18,10 @@ import warnings
 
 import numpy as np
 
-from rough_contact import bem
-from rough_contact.asperity import AsperityMaterial
+from rough_contact.micro import bem
+from rough_contact.micro.asperity import AsperityMaterial
 from rough_contact.interface.normal import NormalLaw
-from rough_contact.spectrum import example_surfaces, fit_spectrum
+from rough_contact.surface.spectrum import example_surfaces, fit_spectrum
 
 E_STAR, NU = 1.067e5, 0.25
 

@@ -1,8 +1,8 @@
 """Statistical vs BEM normal law on the example surfaces: ratios over the load range.
 
-For each surface of rough_contact.spectrum.example_surfaces (isotropic Gaussian, strongly
+For each surface of rough_contact.surface.spectrum.example_surfaces (isotropic Gaussian, strongly
 anisotropic, broadband self-affine; optionally the paper's surface) this runs
-rough_contact.law_comparison's ``compare`` (statistical elastic, GW and - with ``--plastic`` - the
+rough_contact.micro.law_comparison's ``compare`` (statistical elastic, GW and - with ``--plastic`` - the
 elasto-plastic law against the elastic / saturated BEM law, realisations averaged at equal
 separation) and prints and saves the ratios statistical/BEM of p, A/A0 and k at equal separation
 (and A/A0, k at equal load) over the load range, with the load ranges of agreement.
@@ -23,8 +23,8 @@ import os
 
 import numpy as np
 
-from rough_contact import law_comparison as compare_laws
-from rough_contact.spectrum import example_surfaces
+from rough_contact.micro import law_comparison as compare_laws
+from rough_contact.surface.spectrum import example_surfaces
 
 PPW = {"isotropic": 8.0, "anisotropic": 8.0, "self-affine": 4.0, "paper": 4.0}
 SE = {"p_at_h": "se_p", "a_at_h": "se_a", "k_at_h": "se_k", "a_at_p": "se_a", "k_at_p": "se_k"}

@@ -32,6 +32,7 @@ import numpy as np  # noqa: E402
 from mpi4py import MPI  # noqa: E402
 from petsc4py import PETSc  # noqa: E402
 
+from rough_contact.interface.enforcement import AugmentedLagrangian, Penalty
 from rough_contact.interface.penalty import SoftplusPenalty
 from rough_contact.scenes import flat_punch
 from rough_contact.solver.loading import load_path, load_unload_factors
@@ -46,10 +47,11 @@ def run(level: int, mu: float, k: float, width: float, predictor: str, quadratur
         al_tol=1e-3) -> dict:
     mesh_size, contact_size = LEVELS[level]
     law = SoftplusPenalty(k_normal=k, width=width, k_tangential=k, friction=mu,
-                          reversal_stiffness=reversal_stiffness, augmented=augmented,
-                          augmentation_tolerance=al_tol)
+                          reversal_stiffness=reversal_stiffness)
+    enforcement = AugmentedLagrangian(tolerance=al_tol) if augmented else Penalty()
     m = flat_punch.build(comm, mesh_size=mesh_size, contact_size=contact_size, order=1,
-                         load_half_width=10.0, law=law, steps=N_LOAD, quadrature=quadrature)
+                         load_half_width=10.0, law=law, steps=N_LOAD, quadrature=quadrature,
+                         enforcement=enforcement)
     factors = load_unload_factors(N_LOAD, N_LOAD - 1, final_factor=1.0 / N_LOAD)
     t0 = time.process_time()
     incs = []
@@ -86,7 +88,7 @@ def main(argv=None):
     ap.add_argument("--augmented", type=int, nargs="+", default=[0], choices=[0, 1],
                     help="1 = augmented Lagrangian (Uzawa) on top of the penalty")
     ap.add_argument("--al-tol", type=float, default=1e-3,
-                    help="SoftplusPenalty.augmentation_tolerance")
+                    help="AugmentedLagrangian.tolerance")
     ap.add_argument("--csv", default=None)
     ap.add_argument("--verbose", action="store_true")
     args, _petsc = ap.parse_known_args(argv)   # the rest goes to PETSc

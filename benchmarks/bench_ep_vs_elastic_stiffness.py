@@ -4,7 +4,7 @@ For the beam's three surfaces (Table 1 moments with m00 = 0.625, 0.3125, 0.0625 
 plasticity indices psi = 0.35 and 0.5 of Figs 7-8, and nominal pressures p = W/A0, prints the
 separation h where each population model carries p (Newton on the model's own exact stiffness,
 k = -dp/dh), A/A0 there, both stiffnesses and their relative difference
-``k_ep/k_el - 1`` — directly from the population integrals (rough_contact.population), no table.
+``k_ep/k_el - 1`` — directly from the population integrals (rough_contact.micro.population), no table.
 
 Material readings (``--reading``):
   project (default): the project's reading behind eq (74), as in demos/demo_micro_model.py
@@ -28,8 +28,8 @@ import time
 
 import numpy as np
 
-from rough_contact import population
-from rough_contact.asperity import AsperityMaterial
+from rough_contact.micro import population
+from rough_contact.micro.asperity import AsperityMaterial
 from rough_contact.surface import SpectralMoments
 
 MOMENTS = dict(m20=8e-5, m02=8e-4, m40=1.04e-6, m04=1.04e-4)       # Table 1, um convention

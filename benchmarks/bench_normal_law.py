@@ -21,8 +21,8 @@ import time
 
 import numpy as np
 
-from rough_contact import population
-from rough_contact.asperity import AsperityMaterial
+from rough_contact.micro import population
+from rough_contact.micro.asperity import AsperityMaterial
 from rough_contact.interface.normal import NormalLaw
 from rough_contact.surface import SpectralMoments
 

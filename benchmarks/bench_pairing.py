@@ -18,7 +18,8 @@ and the time of one interface residual + Jacobian assembly (law: Coulomb penalty
 DOLFINx's assembly of the bulk elasticity Jacobian of the same mesh — a Newton iteration costs at
 least the bulk assembly plus a linear solve, so the ratio is an upper bound of the interface's
 share. "moderate" is the projection with ``sliding="moderate"``: its last column is the time of
-one ``update_pairing`` (projection on the deformed surfaces, new operator and scatter), paid once
+one re-pairing (``begin_increment`` of a sliding pairing: projection on the deformed surfaces,
+new operator and scatter), paid once
 per increment. Serial. Units: mm, N, MPa, s.
 
 Part "newton": the interface's share of complete Newton iterations (residual and Jacobian
@@ -137,15 +138,18 @@ def cost(points, only=None):
                     u.x.scatter_forward()
                     t0 = time.perf_counter()
                     b.set(0.0)
-                    ci.assemble_residual(u, b)
-                    ci.assemble_jacobian(u, A)
+                    ci.evaluate(u)
+                    ci.assemble_residual(b)
+                    ci.evaluate(u)
+                    ci.assemble_jacobian(A)
                     times.append(time.perf_counter() - t0)
                 A.assemble()
                 t_if = min(times)
                 t_re = float("nan")
                 if pairing == "moderate":   # sliding = 'moderate': projection on the deformed
                     t0 = time.perf_counter()  # surfaces, new operator and scatter
-                    ci.update_pairing(u)
+                    ci.commit()       # a converged increment: the next one re-pairs
+                    ci.begin_increment(u)
                     t_re = time.perf_counter() - t0
                 PETSc.Sys.Print(f"{n_target:7d} {label:>9} {pairing:>10} {ci.n_points_global:8d} "
                                 f"{ci.n_groups:7d} {t_setup:8.2f} {t_if:7.3f} {t_bulk:8.3f} "
@@ -195,7 +199,8 @@ def newton(points, only=None):
                 t_re = float("nan")
                 if pairing == "moderate":
                     t0 = MPI.Wtime()
-                    ci.update_pairing(problem.u)
+                    ci.commit()
+                    problem.begin_increment()
                     t_re = MPI.Wtime() - t0
                 PETSc.Sys.Print(f"{n_target:7d} {label:>6} {pairing:>10} "
                                 f"{ci.n_points_global:8d} {problem.num_dofs:8d} "

@@ -16,7 +16,7 @@
 #   from the map's x axis;
 # * a **synthetic height map** from it (random phases, 2 um pixels) with a form added as an
 #   instrument would record it (tilt and curvature), **written to a file and read back**;
-# * the measured-surface route of ``rough_contact.topography``: quadratic detrending, Hann
+# * the measured-surface route of ``rough_contact.surface.topography``: quadratic detrending, Hann
 #   window with its moment correction, FFT moments incl. the mixed ones, rotation to the
 #   principal (grain) axes, validity advice;
 # * the recovered moments and grain angle against the analytic ones (a table), and the same map
@@ -41,7 +41,7 @@ import time
 import numpy as np
 
 from rough_contact.interface.normal import NormalLaw
-from rough_contact.topography import (AnisotropicGaussianPSD, HeightMap, analyze, detrend,
+from rough_contact.surface.topography import (AnisotropicGaussianPSD, HeightMap, analyze, detrend,
                                       read_height_map, synthetic_height_map, write_height_map)
 
 E_STAR = 1.14e5                  # MPa, Tables 1-2

@@ -38,8 +38,8 @@ import time
 
 import numpy as np
 
-from rough_contact import population as pop
-from rough_contact.asperity import AsperityMaterial, shape_factors
+from rough_contact.micro import population as pop
+from rough_contact.micro.asperity import AsperityMaterial, shape_factors
 from rough_contact.interface.tangential import normal_to_tangential_ratio
 from rough_contact.surface import SpectralMoments
 

@@ -3,7 +3,7 @@
 # The flat punch of section 9.2 (rough_contact.scenes.flat_punch: quarter model, E = 200 GPa,
 # nu = 0.25, orthotropic slip-hardening friction of case (b)) is run twice on the same rough
 # surface, once with the statistical elastic law of the package (asperity sums, eqs 52-55) and
-# once with the BEM law of that surface (rough_contact.bem: exact elastic contact of Gaussian
+# once with the BEM law of that surface (rough_contact.micro.bem: exact elastic contact of Gaussian
 # realisations of the surface's spectrum, averaged at equal separation). Everything else -
 # mesh, friction, Mindlin ratio kT = 0.7 kN, seating, load path - is identical, so the
 # differences are the effect of choosing one normal law or the other:
@@ -48,7 +48,7 @@ def parse_args(argv):
     ap.add_argument("--realisations", type=int, default=8)
     ap.add_argument("--ppw", type=float, default=8.0)
     ap.add_argument("--backend", default=None, choices=["tamaas", "numpy"],
-                    help="BEM backend (default: tamaas, rough_contact.bem)")
+                    help="BEM backend (default: tamaas, rough_contact.micro.bem)")
     ap.add_argument("--small", action="store_true", help="test size (< 1 min)")
     ap.add_argument("--outdir", default="results/punch_bem_vs_statistical")
     args, rest = ap.parse_known_args(argv)

@@ -1,7 +1,7 @@
 # # Contact pressure on the interface facets, ParaView-style, from the written XDMF file
 #
 # Reads ``interface.xdmf`` + ``interface.h5`` written by
-# :class:`rough_contact.fem.interface_output.InterfaceWriter` (the facets of the first contact
+# :class:`rough_contact.io.interface_output.InterfaceWriter` (the facets of the first contact
 # surface with one value per facet, the quadrature average of the point values, time = load
 # factor) and draws the contact pressure of one increment as flat-shaded facets with their
 # edges and a colour bar ("Surface With Edges" and ParaView's default "Cool to Warm" map).
@@ -70,7 +70,7 @@ def run_punch(args, petsc_args):
     abort_on_uncaught_exception()  # one failing rank must not leave the others waiting
     from rough_contact.scenes import flat_punch
 
-    from rough_contact.fem.interface_output import InterfaceWriter, prepare_output_dir
+    from rough_contact.io import InterfaceWriter, prepare_output_dir
     from rough_contact.solver.loading import load_path, load_unload_factors
 
     comm = MPI.COMM_WORLD
@@ -95,8 +95,7 @@ def run_punch(args, petsc_args):
 def draw(args):
     import numpy as np
 
-    from rough_contact import plotting
-    from rough_contact.fem.interface_output import read_interface_results
+    from rough_contact.io import plotting, read_interface_results
 
     res = read_interface_results(os.path.join(args.results, "interface.xdmf"))
     if res.cells is None:

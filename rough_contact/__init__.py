@@ -5,9 +5,11 @@ Model: R. Buczkowski and M. Kleiber, "Statistical Models of Rough Surfaces for F
 
 Layers (each imports only those above it in this list):
     validation                        check_scalar, the one input check of every layer
-    surface, asperity, population     pure numpy/scipy rough-surface micro-model
+    surface                           what a rough surface is: moments, spectra, height maps
+    micro                             asperity, summit population, normal-law tables, BEM law
     interface                         pure numpy interface laws at quadrature points
-    fem, solver                       DOLFINx / PETSc (the only packages importing them)
+    fem, solver                       DOLFINx / PETSc (the only packages importing them, with io)
+    io                                results on disk (XDMF, CSV, atomic writes) and plots
 
 Internal unit system: mm, N, MPa (N/mm^2), so stiffnesses per area are in MPa/mm = N/mm^3.
 Spectral moments are given in the paper's micrometre convention at the API boundary

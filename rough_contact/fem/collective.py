@@ -13,6 +13,9 @@ collective) and turns a local failure into a failure on every rank, keeping its 
   naming the failing rank, the exception type and its message.
 
 The design and the reasons are in ``docs/design.md`` (section "Errors").
+
+:func:`run_on_root` is the same rule for work only one rank does (file system work of the
+output writers): root runs it, every rank returns root's result or raises root's error.
 """
 
 from __future__ import annotations
@@ -24,7 +27,7 @@ from mpi4py import MPI
 
 from rough_contact.interface.contract import ConvergenceError
 
-__all__ = ["raise_on_all_ranks"]
+__all__ = ["raise_on_all_ranks", "run_on_root"]
 
 
 def raise_on_all_ranks(comm: MPI.Comm, error: Optional[BaseException]) -> None:
@@ -61,6 +64,32 @@ def raise_on_all_ranks(comm: MPI.Comm, error: Optional[BaseException]) -> None:
         raise RuntimeError(f"rank {rank} raised {name}: {message}") from error
     rank, name, message, _, module, qualname = failures[0]
     raise _convergence_error(module, qualname, f"rank {rank} raised {name}: {message}")
+
+
+def run_on_root(comm: MPI.Comm, root_action, root: int = 0):
+    """Run ``root_action()`` on root; every rank returns its result or raises its error.
+
+    Collective (one ``bcast``): call it on every rank of ``comm``.
+
+    Args:
+        comm: communicator.
+        root_action: callable without arguments, called on ``root`` only; its result and any
+            exception it raises must be picklable.
+        root: the rank that runs ``root_action``.
+
+    Returns:
+        ``root_action()``'s result, on every rank.
+    """
+    result, error = None, None
+    if comm.rank == root:
+        try:
+            result = root_action()
+        except Exception as exc:  # noqa: BLE001 -- re-raised on every rank below
+            error = exc
+    result, error = comm.bcast((result, error), root=root)
+    if error is not None:
+        raise error
+    return result
 
 
 def _convergence_error(module: str, qualname: str, message: str) -> ConvergenceError:

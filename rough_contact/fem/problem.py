@@ -36,6 +36,7 @@ from dolfinx.fem import petsc as fem_petsc
 from mpi4py import MPI
 from petsc4py import PETSc
 
+from rough_contact.fem import compat
 from rough_contact.fem.contact import ContactInterface
 from rough_contact.validation import check_scalar
 
@@ -360,8 +361,36 @@ class ContactProblem:
     def update_solution(self, x: PETSc.Vec) -> None:
         """Copy the SNES iterate ``x`` into ``self.u`` (with ghost values)."""
         x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
-        x.copy(self.u.vector)
+        x.copy(compat.petsc_vector(self.u))
         self.u.x.scatter_forward()
+
+    def solution_vector(self) -> PETSc.Vec:
+        """The PETSc vector of the displacement ``u`` (owned values; after changing it call
+        :meth:`scatter_solution`)."""
+        return compat.petsc_vector(self.u)
+
+    def scatter_solution(self) -> None:
+        """Update the ghost values of ``u`` after its owned values changed."""
+        self.u.x.scatter_forward()
+
+    def owned_solution_values(self) -> np.ndarray:
+        """This rank's owned displacement values (a view) [mm]."""
+        imap = self.V.dofmap.index_map
+        return self.u.x.array[: imap.size_local * self.V.dofmap.index_map_bs]
+
+    def local_solution_values(self) -> np.ndarray:
+        """This rank's displacement values, owned and ghost (a view) [mm]."""
+        return compat.function_values(self.u)
+
+    def owned_dof_coordinates(self) -> np.ndarray:
+        """(n_owned_nodes, 3) coordinates of this rank's owned displacement nodes [mm]."""
+        return self.V.tabulate_dof_coordinates()[: self.V.dofmap.index_map.size_local]
+
+    def begin_increment(self) -> None:
+        """Start a load increment (collective): the interface's sliding pairing may re-pair on
+        the committed configuration; the matrices follow its new pattern."""
+        if self.interface is not None and self.interface.begin_increment(self.u):
+            self.rebuild_matrices()
 
     def F(self, snes, x: PETSc.Vec, b: PETSc.Vec) -> None:
         """Residual ``b = K x - lam f + lift + R_c(x)``, with ``b = x - g`` on Dirichlet rows."""
@@ -373,7 +402,8 @@ class ContactProblem:
         b.axpy(1.0, self.lift)
         t1 = MPI.Wtime()
         if self.interface is not None:
-            self.interface.assemble_residual(self.u, b)
+            self.interface.evaluate(self.u)
+            self.interface.assemble_residual(b)
         t2 = MPI.Wtime()
         fem_petsc.set_bc(b, self.bcs, x, -1.0)
         self.timings["bulk"] += t1 - t0
@@ -403,13 +433,17 @@ class ContactProblem:
             self.A.setNearNullSpace(ns)
 
     def J(self, snes, x: PETSc.Vec, A: PETSc.Mat, P: PETSc.Mat) -> None:
-        """Consistent Jacobian ``K + dR_c/du`` (plus the seating spring while nothing touches)."""
+        """Consistent Jacobian ``K + dR_c/du`` (plus the seating spring while nothing touches).
+
+        The interface part is that of the last residual evaluation: SNES always evaluates the
+        residual at an iterate before its Jacobian (its line searches end with the residual
+        at the accepted iterate), so the law runs once per Newton iteration."""
         self.update_solution(x)
         t0 = MPI.Wtime()
         self.K.copy(A, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
         t1 = MPI.Wtime()
-        if self.interface is not None:
-            self.interface.assemble_jacobian(self.u, A)
+        if self.interface is not None:   # at the iterate of the last residual (SNES order)
+            self.interface.assemble_jacobian(A)
         A.assemble()
         t2 = MPI.Wtime()
         self.seating_active = False

@@ -71,8 +71,8 @@ from typing import Optional, Protocol, TypeVar, runtime_checkable
 import numpy as np
 
 __all__ = ["ConvergenceError", "LawState", "LawResult", "InterfaceLawProtocol",
-           "FrictionBoundedLaw", "NewtonTangentLaw", "AugmentationControl",
-           "AugmentedLagrangianLaw", "LawContractError", "check_jump"]
+           "FrictionBoundedLaw", "NewtonTangentLaw", "MultiplierLaw", "LawContractError",
+           "check_jump"]
 
 
 class ConvergenceError(ArithmeticError):
@@ -219,51 +219,23 @@ class NewtonTangentLaw(Protocol):
         ...
 
 
-@dataclass(frozen=True)
-class AugmentationControl:
-    """How the load stepping iterates an augmented-Lagrangian law's multipliers (Uzawa).
-
-    Attributes:
-        tolerance: the multipliers are converged when the largest change of one update, over
-            all points and ranks, is at most ``tolerance`` times the largest traction
-            magnitude |t| of the interface [-].
-        max_updates: multiplier updates allowed per load increment; beyond them the increment
-            counts as not converged (the load stepping cuts back).
-    """
-
-    tolerance: float
-    max_updates: int
-
-
 @runtime_checkable
-class AugmentedLagrangianLaw(Protocol):
-    """A penalty law whose constraints are enforced exactly by multipliers updated between
-    Newton solves (Uzawa's augmented-Lagrangian iteration).
+class MultiplierLaw(Protocol):
+    """A penalty law that can be shifted by Lagrange multipliers, so that an enforcement
+    strategy (``rough_contact.interface.enforcement.AugmentedLagrangian``) imposes its contact
+    and stick constraints exactly.
 
-    Within one Newton solve the multipliers are held in the committed state (at the start of
-    an increment extrapolated from the last two by :meth:`extrapolate`, with the secant
-    predictor); after the solve
-    converged the load stepping (``rough_contact.solver.loading``) asks the interface for an
-    update, which calls :meth:`augment`; if the multipliers moved by more than the tolerance
-    of :meth:`augmentation` it solves again with the updated ones, else it commits. A failed
-    increment restores the multipliers the increment started from. The protocol is optional:
-    a law without it (or whose :meth:`augmentation` returns None) is a plain penalty law."""
+    The multipliers are (n, 3) ``[lambda_N, lambda_x, lambda_y]``: the contact pressure
+    lambda_N >= 0 and the tangential traction the penalty is shifted by [MPa]. At the fixed
+    point of the multiplier updates (lambda <- the converged tractions [p, t_x, t_y]) the
+    penalty's elastic gap and elastic slip vanish. The multipliers are kept by the interface's
+    history, not by the law state: a law with this capability is still an ordinary law (its
+    ``evaluate`` is the unshifted penalty)."""
 
-    def augmentation(self) -> Optional[AugmentationControl]:
-        """The iteration's control, or None when the law is used as a plain penalty."""
-        ...
-
-    def augment(self, committed: LawState, result: LawResult) -> tuple[LawState, np.ndarray]:
-        """(``committed`` with its multipliers replaced by those of ``result``, the (n,)
-        magnitude of each point's multiplier change [MPa]); pure, keeps every other history
-        variable of ``committed``."""
-        ...
-
-    def extrapolate(self, committed: LawState, previous: LawState, ratio: float) -> LawState:
-        """``committed`` with its multipliers extrapolated linearly from ``previous`` (the
-        committed state the last converged increment started from): lambda + ratio (lambda -
-        lambda_previous); pure. The load stepping's secant predictor calls it at the start of
-        an increment; the converged result does not depend on it."""
+    def with_multipliers(self, multipliers: np.ndarray) -> InterfaceLawProtocol:
+        """The law with its penalty shifted by ``multipliers`` (n, 3) [MPa]: an object with the
+        same ``initial_state``/``evaluate`` (and ``newton_tangent``, if the law has one) for
+        those n points; cheap to create (no copy of the arrays)."""
         ...
 
 

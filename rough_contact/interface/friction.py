@@ -55,10 +55,11 @@ t = dpsi/djump, jump = (g, s_x, s_y), t_N = -p, so the friction traction t_T poi
 elastic slip s - s_p (it resists the motion of the second body). ``docs/equations.md`` lists
 the readings of (89)-(131) used here.
 
-Entry points: ``evaluate(FrictionInput, traction=, tangent=) -> FrictionOutput`` is what the
+Entry point: ``evaluate(FrictionInput, traction=, tangent=) -> FrictionOutput``, what the
 composed law (``rough_contact.interface.law.InterfaceLaw``) calls at every evaluation (shapes
-checked, values trusted, results written into the caller's arrays); ``return_map`` takes
-(m, 2) pairs, validates every value and returns a dense ``FrictionResult``.
+checked, values trusted, results written into the caller's arrays). Other callers build the
+input with ``FrictionInput.from_pairs`` ((m, 2) pairs, every value validated);
+``FrictionOutput.slipping`` and ``.plastic_increment`` give the dense (m,) / (m, 2) views.
 """
 
 from __future__ import annotations
@@ -76,7 +77,6 @@ __all__ = [
     "IsotropicSlipHardening",
     "FrictionInput",
     "FrictionOutput",
-    "FrictionResult",
     "ReturnMappingError",
     "continuum_tangent",
     "directional_coefficient",
@@ -94,25 +94,6 @@ class ReturnMappingError(ConvergenceError):
 
     A ``ConvergenceError``: a smaller load increment (a smaller slip increment) usually cures it.
     """
-
-
-@dataclass(frozen=True)
-class FrictionResult:
-    """Outcome of a return map at m contact points.
-
-    Attributes:
-        traction: (m, 2) tangential traction (t_x, t_y) [MPa].
-        tangent: (m, 2, 3) d t_T / d(g, s_x, s_y) [MPa/mm] (algorithmic).
-        plastic_increment: (m, 2) Delta s_p [mm].
-        slipping: (m,) bool, the friction limit is active.
-        iterations: number of local Newton iterations used (0 if nothing slipped).
-    """
-
-    traction: np.ndarray
-    tangent: np.ndarray
-    plastic_increment: np.ndarray
-    slipping: np.ndarray
-    iterations: int = 0
 
 
 @dataclass(frozen=True)
@@ -137,7 +118,7 @@ class FrictionInput:
 
     Raises:
         ValueError: a column that is not a 1-D array, or columns of different lengths. Values
-            are not checked here (``evaluate`` is the hot path; ``return_map`` checks them).
+            are not checked here (``evaluate`` is the hot path; ``from_pairs`` checks them).
     """
 
     elastic_slip_x: np.ndarray
@@ -162,6 +143,54 @@ class FrictionInput:
 
     def __len__(self) -> int:
         return self.elastic_slip_x.shape[0]
+
+    @classmethod
+    def from_pairs(cls, elastic_slip, kt, dkt, pressure, kn, accumulated_slip,
+                   slip_path) -> FrictionInput:
+        """The validated input from (m, 2) pairs and (m,) arrays (every value checked).
+
+        Args:
+            elastic_slip: (m, 2) trial elastic slip s - s_p(committed) [mm].
+            kt: (m, 2) tangential stiffnesses (kTx, kTy) > 0 [MPa/mm].
+            dkt: (m, 2) their derivatives d kT / d g [MPa/mm^2].
+            pressure: (m,) contact pressure p >= 0 [MPa].
+            kn: (m,) normal stiffness -dp/dg >= 0 [MPa/mm].
+            accumulated_slip: (m, 2) committed hardening variables kappa_x, kappa_y [mm]
+                (orthotropic law).
+            slip_path: (m,) committed effective plastic slip [mm] (isotropic law).
+
+        Raises:
+            ValueError: a wrong shape, a non-finite value, p < 0, kT <= 0 or kN < 0.
+        """
+        e = np.asarray(elastic_slip, dtype=float)
+        if e.ndim != 2 or e.shape[1] != 2:
+            raise ValueError(f"elastic_slip must have shape (m, 2), got {e.shape}")
+        m = e.shape[0]
+        arrs = {}
+        for name, arr, shape in (("kt", kt, (m, 2)), ("dkt", dkt, (m, 2)),
+                                 ("pressure", pressure, (m,)), ("kn", kn, (m,)),
+                                 ("accumulated_slip", accumulated_slip, (m, 2)),
+                                 ("slip_path", slip_path, (m,))):
+            a = np.asarray(arr, dtype=float)
+            if a.shape != shape:
+                raise ValueError(f"{name} must have shape {shape}, got {a.shape}")
+            arrs[name] = a
+        for name in arrs:
+            if not np.isfinite(arrs[name]).all():
+                raise ValueError(f"{name} must be finite at every point")
+        if not np.isfinite(e).all():
+            raise ValueError("elastic_slip must be finite at every point")
+        if np.any(arrs["pressure"] < 0):
+            raise ValueError("pressure must be >= 0 at every point [MPa]")
+        if np.any(arrs["kt"] <= 0):
+            raise ValueError("kt (tangential stiffness) must be > 0 at every contact point "
+                             "[MPa/mm]")
+        if np.any(arrs["kn"] < 0):
+            raise ValueError("kn (normal stiffness) must be >= 0 at every point [MPa/mm]")
+        kt, dkt, kap = arrs["kt"], arrs["dkt"], arrs["accumulated_slip"]
+        return cls(e[:, 0].copy(), e[:, 1].copy(), kt[:, 0].copy(), kt[:, 1].copy(),
+                   dkt[:, 0].copy(), dkt[:, 1].copy(), arrs["pressure"], arrs["kn"],
+                   kap[:, 0].copy(), kap[:, 1].copy(), arrs["slip_path"])
 
     def take(self, idx) -> FrictionInput:
         """The columns at points ``idx`` (a gathered copy)."""
@@ -189,6 +218,21 @@ class FrictionOutput:
     plastic_increment_y: np.ndarray
     path_increment: np.ndarray
     iterations: int
+
+    @property
+    def slipping(self) -> np.ndarray:
+        """(m,) bool, True where the friction limit is active."""
+        out = np.zeros(self.traction.shape[0], dtype=bool)
+        out[self.slip_index] = True
+        return out
+
+    @property
+    def plastic_increment(self) -> np.ndarray:
+        """(m, 2) Delta s_p at all points [mm] (zero where sticking)."""
+        out = np.zeros((self.traction.shape[0], 2))
+        out[self.slip_index, 0] = self.plastic_increment_x
+        out[self.slip_index, 1] = self.plastic_increment_y
+        return out
 
 
 _NO_SLIP = np.zeros(0, dtype=np.intp)
@@ -236,47 +280,6 @@ def _pair(name: str, value, **bounds) -> Tuple[float, float]:
     if arr.shape != (2,):
         raise ValueError(f"{name} must be a scalar or a pair (x, y), got {value!r}")
     return tuple(check_scalar(f"{name}[{axis}]", float(v), **bounds) for axis, v in zip("xy", arr))
-
-
-def _columns(elastic_slip, kt, dkt, pressure, kn, accumulated_slip, slip_path) -> FrictionInput:
-    e = np.asarray(elastic_slip, dtype=float)
-    if e.ndim != 2 or e.shape[1] != 2:
-        raise ValueError(f"elastic_slip must have shape (m, 2), got {e.shape}")
-    m = e.shape[0]
-    arrs = {}
-    for name, arr, shape in (("kt", kt, (m, 2)), ("dkt", dkt, (m, 2)), ("pressure", pressure, (m,)),
-                             ("kn", kn, (m,)), ("accumulated_slip", accumulated_slip, (m, 2)),
-                             ("slip_path", slip_path, (m,))):
-        a = np.asarray(arr, dtype=float)
-        if a.shape != shape:
-            raise ValueError(f"{name} must have shape {shape}, got {a.shape}")
-        arrs[name] = a
-    for name in arrs:
-        if not np.isfinite(arrs[name]).all():
-            raise ValueError(f"{name} must be finite at every point")
-    if not np.isfinite(e).all():
-        raise ValueError("elastic_slip must be finite at every point")
-    if np.any(arrs["pressure"] < 0):
-        raise ValueError("pressure must be >= 0 at every point [MPa]")
-    if np.any(arrs["kt"] <= 0):
-        raise ValueError("kt (tangential stiffness) must be > 0 at every contact point [MPa/mm]")
-    if np.any(arrs["kn"] < 0):
-        raise ValueError("kn (normal stiffness) must be >= 0 at every point [MPa/mm]")
-    kt, dkt, kap = arrs["kt"], arrs["dkt"], arrs["accumulated_slip"]
-    return FrictionInput(e[:, 0].copy(), e[:, 1].copy(), kt[:, 0].copy(), kt[:, 1].copy(),
-                    dkt[:, 0].copy(), dkt[:, 1].copy(), arrs["pressure"], arrs["kn"],
-                    kap[:, 0].copy(), kap[:, 1].copy(), arrs["slip_path"])
-
-
-def _public_result(law, c: FrictionInput) -> FrictionResult:
-    out = law.evaluate(c)
-    m = len(c)
-    dsp = np.zeros((m, 2))
-    slipping = np.zeros(m, dtype=bool)
-    dsp[out.slip_index, 0] = out.plastic_increment_x
-    dsp[out.slip_index, 1] = out.plastic_increment_y
-    slipping[out.slip_index] = True
-    return FrictionResult(out.traction, out.tangent, dsp, slipping, out.iterations)
 
 
 def _norm(x, y):
@@ -496,28 +499,6 @@ class OrthotropicSlipHardening:
         t = np.asarray(traction_t, dtype=float)
         return np.hypot(t[:, 0] / mu[:, 0], t[:, 1] / mu[:, 1]) - np.asarray(pressure, dtype=float)
 
-    # -- return map ---------------------------------------------------------------------
-    def return_map(self, elastic_slip, kt, dkt, pressure, kn, accumulated_slip, slip_path):
-        """Backward-Euler return map at m contact points (all arrays batch-first).
-
-        Args:
-            elastic_slip: (m, 2) trial elastic slip s - s_p(committed) [mm].
-            kt: (m, 2) tangential stiffnesses (kTx, kTy) > 0 [MPa/mm].
-            dkt: (m, 2) their derivatives d kT / d g [MPa/mm^2].
-            pressure: (m,) contact pressure p >= 0 [MPa].
-            kn: (m,) normal stiffness -dp/dg >= 0 [MPa/mm].
-            accumulated_slip: (m, 2) committed hardening variables kappa_x, kappa_y [mm].
-            slip_path: (m,) committed effective plastic slip (unused by this law) [mm].
-
-        Returns:
-            FrictionResult (traction, tangent (m, 2, 3) wrt (g, s_x, s_y), Delta s_p, slipping).
-
-        Raises:
-            ValueError: wrong shapes or non-physical inputs. ReturnMappingError: no convergence.
-        """
-        return _public_result(self, _columns(elastic_slip, kt, dkt, pressure, kn,
-                                             accumulated_slip, slip_path))
-
     def evaluate(self, points: FrictionInput, traction: Optional[np.ndarray] = None,
                  tangent: Optional[np.ndarray] = None) -> FrictionOutput:
         """Backward-Euler return map and algorithmic tangent at m contact points (hot path).
@@ -526,7 +507,7 @@ class OrthotropicSlipHardening:
         ``tangent`` when given (e.g. views into the composed law's (n, 3) and (n, 3, 3) arrays,
         which saves a copy), else into new arrays. Only shapes are checked here; the values are
         trusted (finite, p >= 0, kT > 0: what the composed law produces from a finite jump);
-        ``return_map`` is the validated entry point for other callers.
+        callers with unchecked data build ``points`` with ``FrictionInput.from_pairs``.
 
         Args:
             points: the inputs at m points (``FrictionInput``).
@@ -678,14 +659,6 @@ class IsotropicSlipHardening:
         t = np.asarray(traction_t, dtype=float)
         return np.hypot(t[:, 0], t[:, 1]) - mu * np.asarray(pressure, dtype=float)
 
-    def return_map(self, elastic_slip, kt, dkt, pressure, kn, accumulated_slip, slip_path):
-        """Backward-Euler return map; arguments and result as ``OrthotropicSlipHardening``.
-
-        ``accumulated_slip`` is unused; ``slip_path`` (m,) is the hardening variable [mm].
-        """
-        return _public_result(self, _columns(elastic_slip, kt, dkt, pressure, kn,
-                                             accumulated_slip, slip_path))
-
     def evaluate(self, points: FrictionInput, traction: Optional[np.ndarray] = None,
                  tangent: Optional[np.ndarray] = None) -> FrictionOutput:
         """Return map (radial when kTx == kTy) and algorithmic tangent at m points (hot path).
@@ -694,7 +667,7 @@ class IsotropicSlipHardening:
         ``tangent`` when given (e.g. views into the composed law's (n, 3) and (n, 3, 3) arrays,
         which saves a copy), else into new arrays. Only shapes are checked here; the values are
         trusted (finite, p >= 0, kT > 0: what the composed law produces from a finite jump);
-        ``return_map`` is the validated entry point for other callers.
+        callers with unchecked data build ``points`` with ``FrictionInput.from_pairs``.
 
         Args:
             points: the inputs at m points (``FrictionInput``).

@@ -18,10 +18,10 @@ import numpy as np
 from scipy.special import expit
 
 from ..validation import check_scalar
-from .contract import AugmentationControl, LawResult, check_jump
-from .state import AugmentedState, InterfaceState
+from .contract import LawResult, check_jump
+from .state import InterfaceState
 
-__all__ = ["LinearPenalty", "SoftplusPenalty"]
+__all__ = ["LinearPenalty", "SoftplusPenalty", "ShiftedSoftplusPenalty"]
 
 
 def _check_inputs(jump, committed) -> np.ndarray:
@@ -108,20 +108,16 @@ class SoftplusPenalty:
     iterations at level 1, 237 -> 202 at level 3). ``reversal_stiffness = 0`` gives the
     consistent tangent everywhere.
 
-    Augmented Lagrangian (``augmented=True``; Uzawa's iteration, for friction Simo and
-    Laursen's scheme): the penalty is shifted by multipliers kept in the history
-    (:class:`~rough_contact.interface.state.AugmentedState`), p = k_N w softplus((lambda_N /
-    k_N - g) / w) and tau = lambda_T + k_T (s - s_p), with the same radial return. The load
-    stepping re-solves each increment with the multipliers replaced by the tractions of the
-    converged solution (:meth:`augment`) until they stop moving (``augmentation_tolerance`` of
-    the largest traction). At that fixed point k_N g -> 0 in contact (up to the softplus
-    smoothing) and s = s_p: a sticking point does not move, a slipping point slips only
-    plastically, so the result no longer depends on k_N, k_T (docs/coulomb.md); the penalty
-    sets only how fast the multipliers converge. The committed multipliers (the converged
-    tractions: a stuck point keeps its traction with zero elastic slip) start the next
-    increment, extrapolated in the load by the load stepping's secant predictor
-    (:meth:`extrapolate`). The virgin state has zero multipliers. On P1/Q1 facets use the
-    vertex rule: exact constraints at several Gauss points per facet lock.
+    Multipliers (:class:`~rough_contact.interface.contract.MultiplierLaw`): ``with_multipliers``
+    gives the law with its penalty shifted by multipliers lambda = (lambda_N, lambda_x,
+    lambda_y), p = k_N w softplus((lambda_N / k_N - g) / w) and tau = lambda_T + k_T (s - s_p),
+    with the same radial return. The augmented-Lagrangian enforcement
+    (``rough_contact.interface.enforcement.AugmentedLagrangian``; Uzawa's iteration, for
+    friction Simo and Laursen's scheme) re-solves each increment with lambda replaced by the
+    converged tractions until they stop moving. At that fixed point k_N g -> 0 in contact (up
+    to the softplus smoothing) and s = s_p: a sticking point does not move, a slipping point
+    slips only plastically, so the result no longer depends on k_N, k_T (docs/coulomb.md); the
+    penalty sets only how fast the multipliers converge.
 
     Args:
         k_normal: normal stiffness k_N > 0 [MPa/mm].
@@ -131,14 +127,6 @@ class SoftplusPenalty:
         reversal_stiffness: factor >= 0 [-] of the secant stiffness added along m at points
             whose slip direction reversed between two Jacobians (Newton steps only, see
             above; 0 = off).
-        augmented: enforce the contact and stick constraints exactly by an augmented-
-            Lagrangian (Uzawa) iteration on the multipliers (see above); False = plain penalty.
-        augmentation_tolerance: convergence of the multipliers, relative to the largest traction
-            magnitude of the interface (0 < tol < 1) [-]. Keep it above about 1e-8: the Newton
-            solves are accurate to rtol 1e-9 of the step's first residual, and the multiplier
-            changes stall there.
-        max_augmentations: multiplier updates per load increment (>= 1) before the increment
-            counts as not converged (cutback).
     """
 
     k_normal: float
@@ -146,9 +134,6 @@ class SoftplusPenalty:
     k_tangential: float = 0.0
     friction: float = 0.0
     reversal_stiffness: float = 1.0
-    augmented: bool = False
-    augmentation_tolerance: float = 1e-3
-    max_augmentations: int = 30
 
     def __post_init__(self) -> None:
         check_scalar("k_normal", self.k_normal, lo=0.0, unit="MPa/mm")
@@ -156,62 +141,23 @@ class SoftplusPenalty:
         check_scalar("k_tangential", self.k_tangential, lo=0.0, lo_open=False, unit="MPa/mm")
         check_scalar("friction", self.friction, lo=0.0, lo_open=False)
         check_scalar("reversal_stiffness", self.reversal_stiffness, lo=0.0, lo_open=False)
-        if not isinstance(self.augmented, bool):
-            raise ValueError(f"augmented = {self.augmented!r} is invalid: it must be True or False")
-        check_scalar("augmentation_tolerance", self.augmentation_tolerance, lo=0.0, hi=1.0,
-                     hi_open=True)
-        if (not isinstance(self.max_augmentations, (int, np.integer))
-                or isinstance(self.max_augmentations, bool) or self.max_augmentations < 1):
-            raise ValueError(f"max_augmentations = {self.max_augmentations!r} is invalid: it "
-                             "must be an integer >= 1")
 
     def initial_state(self, n_pts: int) -> InterfaceState:
-        """Virgin history (no plastic slip; zero multipliers if augmented) at n_pts points."""
-        return AugmentedState.zeros(n_pts) if self.augmented else InterfaceState.zeros(n_pts)
+        """Virgin history (no plastic slip) at n_pts points."""
+        return InterfaceState.zeros(n_pts)
 
-    def augmentation(self) -> Optional[AugmentationControl]:
-        """The Uzawa iteration's control if ``augmented``, else None
-        (``rough_contact.interface.contract.AugmentedLagrangianLaw``)."""
-        if not self.augmented:
-            return None
-        return AugmentationControl(float(self.augmentation_tolerance),
-                                   int(self.max_augmentations))
+    def with_multipliers(self, multipliers: np.ndarray) -> ShiftedSoftplusPenalty:
+        """The law with its penalty shifted by ``multipliers`` (n, 3) [MPa]
+        (``rough_contact.interface.contract.MultiplierLaw``)."""
+        return ShiftedSoftplusPenalty(self, multipliers)
 
-    def augment(self, committed: InterfaceState, result: LawResult
-                ) -> tuple[InterfaceState, np.ndarray]:
-        """``committed`` with the multipliers of ``result`` (its tractions), and the (n,)
-        magnitude of the change [MPa]; pure. Plastic slip and hardening stay committed ones."""
-        if not (self.augmented and isinstance(committed, AugmentedState)
-                and isinstance(result.state, AugmentedState)):
-            raise ValueError("augment needs augmented=True and AugmentedState histories "
-                             f"(got augmented={self.augmented}, committed "
-                             f"{type(committed).__name__}, trial {type(result.state).__name__})")
-        new = committed.copy()
-        new.multiplier = result.state.multiplier.copy()
-        return new, np.linalg.norm(new.multiplier - committed.multiplier, axis=1)
-
-    def extrapolate(self, committed: InterfaceState, previous: InterfaceState, ratio: float
-                    ) -> InterfaceState:
-        """``committed`` with the multipliers extrapolated linearly in the load,
-        lambda + ratio (lambda - lambda_previous); pure. Plastic slip and hardening stay."""
-        if not (self.augmented and isinstance(committed, AugmentedState)
-                and isinstance(previous, AugmentedState) and len(previous) == len(committed)):
-            raise ValueError("extrapolate needs augmented=True and two AugmentedState histories "
-                             "of the same points")
-        new = committed.copy()
-        new.multiplier += ratio * (committed.multiplier - previous.multiplier)
-        new.multiplier[:, 0] = np.maximum(new.multiplier[:, 0], 0.0)
-        return new
-
-    def _shifts(self, committed: InterfaceState):
+    def _shifts(self, multipliers: Optional[np.ndarray]):
         """(gap shift lambda_N / k_N (n,) [mm], tangential multiplier (n, 2) [MPa]); the scalar
-        0.0 for both when the law is not augmented."""
-        if self.augmented:
-            if not isinstance(committed, AugmentedState):
-                raise ValueError("augmented=True needs the AugmentedState of initial_state, got "
-                                 f"{type(committed).__name__}")
-            return committed.multiplier[:, 0] / self.k_normal, committed.multiplier[:, 1:]
-        return 0.0, 0.0
+        0.0 for both without multipliers."""
+        if multipliers is None:
+            return 0.0, 0.0
+        lam = np.asarray(multipliers)
+        return lam[:, 0] / self.k_normal, lam[:, 1:]
 
     def _trial_traction(self, jump: np.ndarray, committed: InterfaceState,
                         lam_t) -> np.ndarray:
@@ -228,8 +174,10 @@ class SoftplusPenalty:
         z = -np.asarray(g, dtype=float) / self.width
         return self.k_normal * self.width * np.logaddexp(0.0, z), self.k_normal * expit(z)
 
-    def evaluate(self, jump: np.ndarray, committed: InterfaceState) -> LawResult:
+    def evaluate(self, jump: np.ndarray, committed: InterfaceState,
+                 multipliers: Optional[np.ndarray] = None) -> LawResult:
         """Traction (n, 3) and tangent (n, 3, 3) at jump (n, 3) [mm]; pure (no mutation).
+        ``multipliers`` (n, 3) shift the penalty (see the class; None: the plain penalty).
 
         The trial state carries the plastic slip and, for the record, the slip magnitudes
         (``accumulated_slip``, ``slip_path``); Coulomb friction does not harden.
@@ -239,7 +187,10 @@ class SoftplusPenalty:
         """
         jump = _check_inputs(jump, committed)
         n = jump.shape[0]
-        shift, lam_t = self._shifts(committed)
+        if multipliers is not None and np.shape(multipliers) != (n, 3):
+            raise ValueError(f"multipliers of shape {np.shape(multipliers)} for {n} points; "
+                             f"expected ({n}, 3)")
+        shift, lam_t = self._shifts(multipliers)
         p, k = self.normal(jump[:, 0] - shift)
         traction = np.zeros((n, 3))
         tangent = np.zeros((n, 3, 3))
@@ -275,9 +226,6 @@ class SoftplusPenalty:
                 state.accumulated_slip[slipping] += np.abs(dslip)
                 state.slip_path[slipping] += (ns - ls) / kt
                 dissipation[slipping] = np.einsum("ij,ij->i", traction[slipping, 1:], dslip)
-        if self.augmented:
-            state.multiplier[:, 0] = p
-            state.multiplier[:, 1:] = traction[:, 1:]
         return LawResult(
             traction=traction,
             tangent=tangent,
@@ -289,7 +237,9 @@ class SoftplusPenalty:
         )
 
     def newton_tangent(self, jump: np.ndarray, committed: InterfaceState, result: LawResult,
-                       previous: Optional[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+                       previous: Optional[np.ndarray],
+                       multipliers: Optional[np.ndarray] = None
+                       ) -> tuple[np.ndarray, np.ndarray]:
         """Tangent for a Newton step at ``jump`` (pure; the residual is not affected).
 
         Args:
@@ -304,10 +254,11 @@ class SoftplusPenalty:
             stiffness ``reversal_stiffness`` k_T |t_T| / |tau| added along m = tau / |tau| at
             slipping points whose trial direction reversed since ``previous`` (see the
             class); memo = (n, 2) trial directions m, to pass as ``previous`` next time.
+            ``multipliers``: those ``result`` was computed with (None: plain penalty).
         """
         if self.k_tangential <= 0.0:
             return result.tangent, None
-        tau = self._trial_traction(jump, committed, self._shifts(committed)[1])
+        tau = self._trial_traction(jump, committed, self._shifts(multipliers)[1])
         norm = np.linalg.norm(tau, axis=1)
         m = np.divide(tau, norm[:, None], out=np.zeros_like(tau), where=norm[:, None] > 0.0)
         tangent = result.tangent
@@ -321,3 +272,28 @@ class SoftplusPenalty:
                           * np.linalg.norm(result.traction[flip, 1:], axis=1) / norm[flip])
                 tangent[flip, 1:, 1:] += secant[:, None, None] * mf[:, :, None] * mf[:, None, :]
         return tangent, m
+
+
+@dataclass(frozen=True)
+class ShiftedSoftplusPenalty:
+    """A :class:`SoftplusPenalty` with its penalty shifted by multipliers (n, 3) [MPa]: what
+    ``SoftplusPenalty.with_multipliers`` returns for one evaluation of n points."""
+
+    law: SoftplusPenalty
+    multipliers: np.ndarray
+
+    def initial_state(self, n_pts: int) -> InterfaceState:
+        """Virgin history at n_pts points (that of the plain law)."""
+        return self.law.initial_state(n_pts)
+
+    def evaluate(self, jump: np.ndarray, committed: InterfaceState) -> LawResult:
+        """The shifted law at ``jump`` (see :meth:`SoftplusPenalty.evaluate`)."""
+        return self.law.evaluate(jump, committed, self.multipliers)
+
+    def newton_tangent(self, jump, committed, result, previous):
+        """See :meth:`SoftplusPenalty.newton_tangent`."""
+        return self.law.newton_tangent(jump, committed, result, previous, self.multipliers)
+
+    def max_friction_coefficient(self) -> float:
+        """That of the plain law."""
+        return self.law.max_friction_coefficient()

@@ -11,12 +11,13 @@ the dissipation increment of a step; ``StatePair`` is where it is summed.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Optional
 
 import numpy as np
 
 from .contract import LawResult, LawState
 
-__all__ = ["InterfaceState", "AugmentedState", "StatePair"]
+__all__ = ["InterfaceState", "StatePair", "InterfaceHistory"]
 
 
 @dataclass
@@ -59,40 +60,6 @@ class InterfaceState:
 
     def __len__(self) -> int:
         return self.plastic_slip.shape[0]
-
-
-@dataclass
-class AugmentedState(InterfaceState):
-    """History of an augmented-Lagrangian penalty law: :class:`InterfaceState` plus multipliers.
-
-    Attributes:
-        multiplier: (n, 3) [lambda_N, lambda_x, lambda_y]: the contact pressure lambda_N >= 0
-            and the tangential traction (lambda_x, lambda_y) the penalty is shifted by [MPa].
-            In a law evaluation they are the tractions of the trial point; in the committed
-            state, those of the last multiplier update (within an increment) or of the last
-            converged increment.
-    """
-
-    multiplier: np.ndarray = None
-
-    def __post_init__(self) -> None:
-        super().__post_init__()
-        n = len(self)
-        if not isinstance(self.multiplier, np.ndarray) or self.multiplier.shape != (n, 3):
-            raise ValueError(f"AugmentedState.multiplier must be an ndarray of shape ({n}, 3), "
-                             f"got {np.shape(self.multiplier)}")
-
-    @classmethod
-    def zeros(cls, n_pts: int) -> AugmentedState:
-        """Virgin state (no slip, no hardening, zero multipliers) at n_pts points."""
-        base = InterfaceState.zeros(n_pts)
-        return cls(base.plastic_slip, base.accumulated_slip, base.slip_path,
-                   np.zeros((len(base), 3)))
-
-    def copy(self) -> AugmentedState:
-        """Deep copy."""
-        return AugmentedState(self.plastic_slip.copy(), self.accumulated_slip.copy(),
-                              self.slip_path.copy(), self.multiplier.copy())
 
 
 class StatePair:
@@ -145,8 +112,8 @@ class StatePair:
         self._pending = np.zeros_like(self.dissipated)
 
     def restore(self, committed: LawState, dissipated: np.ndarray) -> None:
-        """Set the committed state and the accumulated dissipation, dropping the trial (resuming a
-        checkpoint; an augmented-Lagrangian multiplier update, or undoing one)."""
+        """Set the committed state and the accumulated dissipation, dropping the trial
+        (resuming a checkpoint)."""
         if not isinstance(committed, LawState) or len(committed) != len(self.committed):
             raise ValueError(f"restored state ({type(committed).__name__}, "
                              f"{len(committed) if isinstance(committed, LawState) else '?'} "
@@ -164,3 +131,99 @@ class StatePair:
         """Discard the trial state and its dissipation (the global Newton failed; cutback)."""
         self.trial = self.committed.copy()
         self._pending = np.zeros_like(self.dissipated)
+
+
+class InterfaceHistory:
+    """Everything an interface remembers between increments, in one object.
+
+    * the law's history (:class:`StatePair`: committed and trial state, dissipation);
+    * the multipliers of an enforcement that has them (committed; the trial ones, the tractions
+      of the accepted iterate, which the commit makes the next increment's start; those the
+      increment started from, to undo its updates on a revert; those the last converged
+      increment started from, for the secant predictor);
+    * the pairing of a sliding pairing (an opaque, picklable object and the jump offsets it
+      set), None for a fixed pairing.
+
+    ``commit`` after a converged increment, ``revert`` after a failed one; ``state()`` is one
+    picklable dict a checkpoint stores and ``restore`` reinstates.
+
+    Args:
+        law_state: the law's virgin state.
+        multipliers: (n, 3) virgin multipliers [MPa], or None.
+    """
+
+    def __init__(self, law_state: LawState, multipliers: Optional[np.ndarray] = None):
+        self.law = StatePair(law_state)
+        self.multipliers = None if multipliers is None else np.asarray(multipliers, float)
+        self.multipliers_before: Optional[np.ndarray] = None
+        self._multipliers_start: Optional[np.ndarray] = None
+        self._multipliers_trial: Optional[np.ndarray] = None
+        self.pairing: Optional[object] = None
+
+    # ------------------------------------------------------------------ lifecycle
+    def set_multipliers(self, new: np.ndarray) -> None:
+        """Replace the committed multipliers within the current increment (an update or the
+        predictor); the trial law state is dropped; :meth:`revert` undoes it."""
+        if self.multipliers is None or np.shape(new) != self.multipliers.shape:
+            raise ValueError(f"multipliers of shape {np.shape(new)}; this history holds "
+                             f"{None if self.multipliers is None else self.multipliers.shape}")
+        if self._multipliers_start is None:
+            self._multipliers_start = self.multipliers
+        self.multipliers = new
+        self._multipliers_trial = None
+        self.law.revert()
+
+    def propose_multipliers(self, trial: np.ndarray) -> None:
+        """The multipliers the commit will make the committed ones (the converged tractions:
+        within the tolerance of those used, and the next increment starts from them)."""
+        if self.multipliers is None or np.shape(trial) != self.multipliers.shape:
+            raise ValueError(f"trial multipliers of shape {np.shape(trial)}; this history "
+                             f"holds {None if self.multipliers is None else self.multipliers.shape}")
+        self._multipliers_trial = trial
+
+    def commit(self) -> None:
+        """Accept the trial state (the global Newton converged and the enforcement is done)."""
+        if self.multipliers is not None:
+            self.multipliers_before = (self._multipliers_start
+                                       if self._multipliers_start is not None
+                                       else self.multipliers)
+            if self._multipliers_trial is not None:
+                self.multipliers = self._multipliers_trial
+        self._multipliers_start = self._multipliers_trial = None
+        self.law.commit()
+
+    def revert(self) -> None:
+        """Drop the trial state and the multiplier changes of the current increment."""
+        if self._multipliers_start is not None:
+            self.multipliers = self._multipliers_start
+            self._multipliers_start = None
+        self._multipliers_trial = None
+        self.law.revert()
+
+    # ------------------------------------------------------------------ checkpoints
+    def state(self) -> dict:
+        """The committed history as one picklable dict (for checkpoints)."""
+        return dict(committed=self.law.committed, dissipated=self.law.dissipated,
+                    multipliers=self.multipliers, multipliers_before=self.multipliers_before,
+                    pairing=self.pairing)
+
+    def restore(self, state: dict) -> None:
+        """Reinstate :meth:`state` (the trial state is dropped).
+
+        Raises:
+            ValueError: the state belongs to another interface (point count, multipliers).
+        """
+        self.law.restore(state["committed"], state["dissipated"])
+        lam, before = state["multipliers"], state["multipliers_before"]
+        for name, value in (("multipliers", lam), ("multipliers_before", before)):
+            if value is not None and (self.multipliers is None
+                                      or np.shape(value) != self.multipliers.shape):
+                raise ValueError(f"restored {name} of shape {np.shape(value)}; this interface "
+                                 f"holds {None if self.multipliers is None else self.multipliers.shape}")
+        if (lam is None) != (self.multipliers is None):
+            raise ValueError("the restored history and this interface differ in enforcement "
+                             "(multipliers present in one only)")
+        self.multipliers = None if lam is None else np.array(lam)
+        self.multipliers_before = None if before is None else np.array(before)
+        self._multipliers_start = self._multipliers_trial = None
+        self.pairing = state["pairing"]

@@ -27,11 +27,11 @@ from rough_contact.fem.contact import ContactInterface
 from rough_contact.fem.mesh import Scene
 from rough_contact.fem.problem import ContactProblem, Material, SurfaceLoad
 from rough_contact.interface.law import InterfaceLaw
+from rough_contact.io import ResultWriter, atomic_write_text, gather_points
 from rough_contact.scenes.defaults import SEATING_STIFFNESS
 from rough_contact.scenes.defaults import quadrature_degree as default_qdeg
 from rough_contact.scenes.meshes.beam import beam_on_base
 from rough_contact.solver.loading import load_path
-from rough_contact.solver.output import ResultWriter, atomic_write_text, gather_points
 from rough_contact.solver.snes import SNESSolver
 from rough_contact.validation import check_scalar
 
@@ -89,7 +89,7 @@ def make_normal_law(comm, m00, normal_law, hardness="psi"):
         if normal_law == "elastic":
             normal = NormalLaw.elastic(surface, E_STAR)
         else:
-            from rough_contact.asperity import AsperityMaterial
+            from rough_contact.micro.asperity import AsperityMaterial
 
             data = dict(PLASTIC)
             if hardness == "tabor":

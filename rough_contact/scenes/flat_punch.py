@@ -33,12 +33,12 @@ from rough_contact.fem.contact import ContactInterface
 from rough_contact.fem.mesh import Scene
 from rough_contact.fem.problem import ContactProblem, Material, SurfaceLoad
 from rough_contact.interface.contract import InterfaceLawProtocol
+from rough_contact.io import ResultWriter, gather_points
 from rough_contact.references import effective_modulus
 from rough_contact.scenes.defaults import GRAIN_X, SEATING_STIFFNESS
 from rough_contact.scenes.defaults import quadrature_degree as default_qdeg
 from rough_contact.scenes.meshes.flat_punch import flat_punch
 from rough_contact.solver.loading import load_path, load_unload_factors
-from rough_contact.solver.output import ResultWriter, gather_points
 from rough_contact.solver.snes import SNESSolver
 from rough_contact.validation import check_scalar
 
@@ -92,7 +92,7 @@ def make_law(comm, law="rough", case="b", normal_law="elastic", seating_pressure
                          "'elastic', 'elasto-plastic'")
     if normal is None:
         if comm.rank == 0:  # the table is built once and copied to the other ranks
-            from rough_contact.asperity import AsperityMaterial
+            from rough_contact.micro.asperity import AsperityMaterial
             from rough_contact.interface.normal import NormalLaw
             from rough_contact.surface import SpectralMoments
 
@@ -178,7 +178,7 @@ def build(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2, load_h
           law="rough", case="b", normal_law="elasto-plastic", steps=16, prefix="rc_",
           dof_threshold=None, quadrature_degree=None, normal=None, seating_steps=None,
           cell_type="tetrahedron", *, punch_scene=None, total_force=TOTAL_FORCE,
-          solver_defaults=None, quadrature="gauss", solver_options=None):
+          solver_defaults=None, quadrature="gauss", solver_options=None, enforcement=None):
     """Mesh, law, interface, problem and solver of the quarter punch. Collective.
 
     ``quadrature`` is the interface rule (``"gauss"`` of ``quadrature_degree``, default 2 x
@@ -195,7 +195,9 @@ def build(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2, load_h
     ``steps``) sets the seating pressure to the nominal pressure of 1/seating_steps of the load.
 
     ``law`` is "rough", "penalty" or any object satisfying the interface-law contract
-    (``rough_contact.interface.contract.InterfaceLawProtocol``), used as given.
+    (``rough_contact.interface.contract.InterfaceLawProtocol``), used as given;
+    ``enforcement`` (``rough_contact.interface.enforcement``: ``Penalty()``, the default, or
+    ``AugmentedLagrangian(...)``) is how the interface imposes it.
 
     Returns:
         :class:`PunchModel`.
@@ -225,7 +227,7 @@ def build(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2, load_h
     qdeg = quadrature_degree if quadrature_degree is not None else default_qdeg(order)
     interface = ContactInterface(V, scene.facet_tags, first, second, law=interface_law,
                                  grain_direction=GRAIN_X, quadrature_degree=qdeg,
-                                 quadrature=quadrature, bcs=bcs)
+                                 quadrature=quadrature, bcs=bcs, enforcement=enforcement)
     materials = {scene.tag("punch"): Material(E, NU), scene.tag("foundation"): Material(E, NU)}
     loads = [SurfaceLoad(scene.tag("load"), force=[0.0, 0.0, -quarter_force])]
     problem = ContactProblem(V, materials, bcs, loads, cell_tags=scene.cell_tags,
@@ -261,8 +263,8 @@ def point_data(interface):
 
 def plot_slip_directions(comm, interface, path, title, n_grid=12):
     """Quiver of the plastic slip directions at contact points (Figs 18-19), about n_grid^2
-    arrows, drawn by :func:`rough_contact.plotting.plot_slip_quiver`. Collective."""
-    from rough_contact import plotting
+    arrows, drawn by :func:`rough_contact.io.plotting.plot_slip_quiver`. Collective."""
+    from rough_contact.io import plotting
 
     pts, fields = gather_points(comm, *point_data(interface))
     if comm.rank != 0:

@@ -31,12 +31,12 @@ from rough_contact.fem.compat import vector_space
 from rough_contact.fem.contact import ContactInterface
 from rough_contact.fem.problem import (ContactProblem, Material, PrescribedDisplacement,
                                        SurfaceLoad)
+from rough_contact.io import CsvRecorder
 from rough_contact.scenes import flat_punch
 from rough_contact.scenes.defaults import SEATING_STIFFNESS, quadrature_degree
 from rough_contact.scenes.meshes.blocks import two_blocks
 from rough_contact.solver.checkpoint import has_checkpoint
 from rough_contact.solver.loading import load_path
-from rough_contact.solver.output import CsvRecorder
 from rough_contact.solver.program import cycle_summary, preload_then_cyclic
 from rough_contact.solver.snes import SNESSolver
 from rough_contact.validation import check_scalar
@@ -204,7 +204,7 @@ def _plot(results, outdir):
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    from rough_contact import plotting
+    from rough_contact.io import plotting
 
     fig = Figure(figsize=(11, 4.4))
     FigureCanvasAgg(fig)

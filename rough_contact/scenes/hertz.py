@@ -29,11 +29,11 @@ from rough_contact.fem.contact import ContactInterface
 from rough_contact.fem.problem import ContactProblem, Material, PrescribedDisplacement
 from rough_contact.fem.rigid import RigidSphere
 from rough_contact.interface.penalty import LinearPenalty
+from rough_contact.io import gather_points
 from rough_contact.references import hertz_peak_pressure, hertz_pressure, hertz_radius
 from rough_contact.scenes.defaults import GRAIN_X, INDENTER_PENALTY, quadrature_degree
 from rough_contact.scenes.meshes.blocks import indented_block
 from rough_contact.solver.loading import load_path
-from rough_contact.solver.output import gather_points
 from rough_contact.solver.snes import SNESSolver
 
 __all__ = ["HertzComparison", "run", "run_elastic"]

@@ -31,6 +31,7 @@ from rough_contact.fem.compat import vector_space
 from rough_contact.fem.contact import ContactInterface
 from rough_contact.fem.problem import ContactProblem, Material, PrescribedDisplacement
 from rough_contact.fem.rigid import RigidSphere
+from rough_contact.interface.enforcement import AugmentedLagrangian, Penalty
 from rough_contact.interface.penalty import SoftplusPenalty
 from rough_contact.references import hertz_force, hertz_radius, sliding_approach
 from rough_contact.scenes.defaults import GRAIN_X, INDENTER_PENALTY
@@ -160,7 +161,7 @@ def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5
     amplitude, beside Mindlin's cubic one (docs/mindlin.md).
 
     ``augmented``: exact contact and stick by the augmented-Lagrangian (Uzawa) iteration of
-    ``SoftplusPenalty(augmented=True)`` with ``augmentation_tolerance``; the penalties then
+    ``SoftplusPenalty`` with ``AugmentedLagrangian(augmentation_tolerance)``; the penalties then
     set only how fast the multipliers converge.
 
     ``slide`` defaults to the approach at which Mindlin's Q reaches mu P for Hertz's P at
@@ -201,8 +202,8 @@ def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5
         k_tangential = KT_SCALE * E / contact_size
     check_scalar("k_tangential", k_tangential, lo=0.0, unit="MPa/mm")
     check_scalar("width_ratio", width_ratio, lo=0.0)
-    law = SoftplusPenalty(penalty, width_ratio * delta, k_tangential=k_tangential, friction=mu,
-                          augmented=augmented, augmentation_tolerance=augmentation_tolerance)
+    law = SoftplusPenalty(penalty, width_ratio * delta, k_tangential=k_tangential, friction=mu)
+    enforcement = AugmentedLagrangian(augmentation_tolerance) if augmented else Penalty()
     if indenter not in ("paraboloid", "sphere"):
         raise ValueError(f"indenter = {indenter!r} is invalid: 'paraboloid' or 'sphere'")
     rigid = ParaboloidIndenter(radius) if indenter == "paraboloid" else \
@@ -210,7 +211,8 @@ def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5
     ci = ContactInterface(V, scene.facet_tags, scene.tag("contact"), law=law,
                           rigid=rigid, bcs=[sym],
                           quadrature_degree=default_qdeg(order) if quadrature_degree is None
-                          else quadrature_degree, grain_direction=GRAIN_X)
+                          else quadrature_degree, grain_direction=GRAIN_X,
+                          enforcement=enforcement)
     bottom = scene.tag("bottom")
     prog = _program(preload_steps, shear_steps, cycles)
     problem = ContactProblem(

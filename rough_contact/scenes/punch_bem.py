@@ -2,7 +2,7 @@
 
 The quarter punch of :mod:`rough_contact.scenes.flat_punch` (E = 200 GPa, nu = 0.25, friction
 case (b)) is loaded twice on the same rough surface, once with the statistical elastic law
-(asperity sums) and once with the BEM law of that surface (:mod:`rough_contact.bem`: exact
+(asperity sums) and once with the BEM law of that surface (:mod:`rough_contact.micro.bem`: exact
 elastic contact of Gaussian realisations of the surface's spectrum). Everything else is
 identical, so the differences are the effect of the normal law: approach of the loaded patch,
 interface closure, int k dA, real contact area, dissipation. The default load is a bolted-joint
@@ -84,9 +84,9 @@ def build_laws(comm, surface, realisations, ppw, small, backend=None):
     if comm.rank == 0:
         import warnings
 
-        from rough_contact import bem
+        from rough_contact.micro import bem
         from rough_contact.interface.normal import NormalLaw
-        from rough_contact.spectrum import example_surfaces
+        from rough_contact.surface.spectrum import example_surfaces
 
         m, shape = example_surfaces()[surface]
         E_star = effective_modulus(punch.E, punch.NU, punch.E, punch.NU)

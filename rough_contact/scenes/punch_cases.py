@@ -18,9 +18,9 @@ from typing import Optional
 import numpy as np
 from mpi4py import MPI
 
+from rough_contact.io import gather_points
 from rough_contact.scenes import flat_punch as demo
 from rough_contact.solver.loading import load_path, load_unload_factors
-from rough_contact.solver.output import gather_points
 
 __all__ = ["Snapshot", "CaseIncrement", "PunchCaseResult", "snapshot", "mirror_asymmetry",
            "run_case", "plot_case", "plot_unloading", "summary_table"]
@@ -230,13 +230,13 @@ def _peak_figures(history, peak: Snapshot, snap: Snapshot) -> dict:
         mirror_peak=mirror_asymmetry(peak), mirror_end=mirror_asymmetry(snap))
 
 
-# ## Figures (rank 0), drawn with rough_contact.plotting
+# ## Figures (rank 0), drawn with rough_contact.io.plotting
 def plot_case(res, path):
     """Three panels: plastic slip directions at peak, after unloading; stick/slip at peak."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    from rough_contact import plotting
+    from rough_contact.io import plotting
 
     fig = Figure(figsize=(15, 4.8))
     FigureCanvasAgg(fig)

@@ -73,8 +73,7 @@ class CheckpointState:
 
 def signature(problem) -> dict:
     """What identifies the problem a checkpoint belongs to (collective)."""
-    V = problem.V
-    x = V.tabulate_dof_coordinates()[: V.dofmap.index_map.size_local]
+    x = problem.owned_dof_coordinates()
     local = float(np.round(x, 9).sum() + 7.0 * np.round(x ** 2, 9).sum())
     ci = problem.interface
     return dict(
@@ -102,13 +101,10 @@ def write_checkpoint(directory: str, problem, state: CheckpointState, sig: dict,
             os.remove(os.path.join(path, name))
     comm.Barrier()
     ci = problem.interface
-    data = dict(u=problem.u.x.array.copy(), u_previous=state.u_previous,
+    data = dict(u=problem.local_solution_values().copy(), u_previous=state.u_previous,
                 partition=_local_checksum(problem),
-                committed=None if ci is None else ci.history.committed,
-                dissipated=None if ci is None else ci.history.dissipated,
-                outputs=[o.checkpoint_state() for o in outputs],
-                pairing=None if ci is None else ci.pairing_state(),
-                interface_predictor=None if ci is None else ci.predictor_state())
+                interface=None if ci is None else ci.state(),
+                outputs=[o.checkpoint_state() for o in outputs])
     with open(os.path.join(path, f"rank{comm.rank}.pkl"), "wb") as f:
         pickle.dump(data, f, protocol=pickle.HIGHEST_PROTOCOL)
         f.flush()
@@ -138,10 +134,9 @@ def has_checkpoint(directory: str, comm: MPI.Comm = MPI.COMM_WORLD) -> bool:
 
 def _local_checksum(problem) -> np.ndarray:
     """(count, checksum) of this rank's owned DOF coordinates."""
-    V = problem.V
-    n = V.dofmap.index_map.size_local
-    x = V.tabulate_dof_coordinates()[:n]
-    return np.array([float(n), float(np.round(x, 9).sum() + 7.0 * np.round(x ** 2, 9).sum())])
+    x = problem.owned_dof_coordinates()
+    return np.array([float(x.shape[0]),
+                     float(np.round(x, 9).sum() + 7.0 * np.round(x ** 2, 9).sum())])
 
 
 def _latest(directory: str) -> Optional[str]:
@@ -192,7 +187,7 @@ def read_checkpoint(directory: str, problem, factors,
     # permutation between ranks; DOLFINx's partitioner may differ between two mesh builds of one
     # process)
     mine_local = _local_checksum(problem)
-    same = (data["u"].shape == problem.u.x.array.shape
+    same = (data["u"].shape == problem.local_solution_values().shape
             and np.allclose(data.get("partition", mine_local), mine_local, rtol=1e-12,
                             atol=1e-9))
     if not comm.allreduce(same, op=MPI.LAND):
@@ -207,16 +202,12 @@ def read_checkpoint(directory: str, problem, factors,
         raise CheckpointError(f"the checkpoint in {directory!r} holds the state of "
                               f"{len(saved_outputs)} output writer(s), {len(outputs)} were given: "
                               "resume with the same outputs")
-    problem.u.x.array[:] = data["u"]
-    problem.u.x.scatter_forward()
+    problem.local_solution_values()[:] = data["u"]
+    problem.scatter_solution()
     problem.set_load_factor(meta["load_factor"])
     ci = problem.interface
-    if ci is not None:
-        ci.history.restore(data["committed"], data["dissipated"])
-        ci.revert()
-        ci.restore_predictor_state(data.get("interface_predictor"))
-        if ci.restore_pairing(data.get("pairing"), problem.u):   # moderate sliding
-            problem.rebuild_matrices()
+    if ci is not None and ci.restore(data["interface"]):   # a sliding pairing's partners
+        problem.rebuild_matrices()
     for writer, saved in zip(outputs, saved_outputs):
         writer.restore(saved)
     return CheckpointState(step=meta["step"], index=meta["index"], delta=meta["delta"],

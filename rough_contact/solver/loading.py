@@ -216,15 +216,6 @@ def _print_increment(inc: Increment) -> None:
     )
 
 
-def _update_pairing(problem: ContactProblem) -> None:
-    """Moderate sliding: pair the surfaces again on the converged configuration before the
-    next increment (after the increment was reported and checkpointed with its own pairing)."""
-    interface = problem.interface
-    if interface is not None and interface.sliding == "moderate":
-        if interface.update_pairing(problem.u):
-            problem.rebuild_matrices()
-
-
 def load_path(problem: ContactProblem, solver: SNESSolver, factors: Iterable[float], *,
               min_increment: float = 1e-4, max_growth: float = 2.0,
               verbose: bool = True, validity: str = "warn",
@@ -256,8 +247,8 @@ def load_path(problem: ContactProblem, solver: SNESSolver, factors: Iterable[flo
             interface history is the committed one either way: the converged result does not
             depend on the choice (to the Newton tolerance), the iteration count does
             (docs/coulomb.md: -67 % / -52 % on the Coulomb punch at mu = 0.2 / 0.5, -19 % on
-            the rough punch). With an augmented-Lagrangian law the multipliers are
-            extrapolated the same way (``ContactInterface.extrapolate_multipliers``; the
+            the rough punch). With an augmented-Lagrangian enforcement the multipliers are
+            extrapolated the same way (``ContactInterface.predict``; the
             converged result does not depend on it, to the multiplier tolerance; 267 -> 86
             Newton iterations on the mu = 0.5 punch).
 
@@ -300,132 +291,172 @@ def load_path(problem: ContactProblem, solver: SNESSolver, factors: Iterable[flo
                          f"{', '.join(VALIDITY_POLICIES)}")
     if max_steps is not None and (int(max_steps) != max_steps or max_steps < 1):
         raise ValueError(f"max_steps = {max_steps!r} is invalid: it must be an integer >= 1")
-    comm = problem.comm
-    factors = list(factors)
-    restored = None
-    done = 0
-    if resume is not None:
-        restored = read_checkpoint(resume, problem, factors, outputs)
-        _update_pairing(problem)   # the checkpoint holds the pairing its increment used
-    sig = None if checkpoint is None else checkpoint_signature(problem)
-    _check_initial_guess(problem)
-    interface = problem.interface
-    u_committed = problem.u.vector.copy()
-    lam_committed = problem.load_factor
-    u_previous, lam_previous = None, None     # the converged state before u_committed
-    step = 0
-    start_index = 0
-    if restored is not None:
-        step, start_index, lam_previous = restored.step, restored.index, restored.lam_previous
-        if restored.u_previous is not None:
-            u_previous = u_committed.duplicate()
-            u_previous.setArray(restored.u_previous)
-    spent = [0, 0, 0]  # Newton its, linear its, failed attempts since the last converged step
-    for i, target in enumerate(factors):
-        if i < start_index:
-            continue
-        target = check_scalar(f"load factor {i} of the load path", target)
-        delta = target - lam_committed
-        cutbacks = 0
-        if restored is not None and i == restored.index:
-            delta, cutbacks = restored.delta, restored.cutbacks
-        t_start = time.perf_counter()
-        while True:
-            if abs(target - lam_committed) <= 1e-14 * max(1.0, abs(target)):
-                break
-            if abs(delta) > abs(target - lam_committed):
-                delta = target - lam_committed
-            lam = lam_committed + delta
-            problem.set_load_factor(lam)
-            if (predictor == "secant" and u_previous is not None
-                    and (lam - lam_committed) * (lam_committed - lam_previous) > 0.0):
-                # u0 = u_n + r (u_n - u_{n-1}), r = (lam - lam_n) / (lam_n - lam_{n-1})
-                r = (lam - lam_committed) / (lam_committed - lam_previous)
-                u_committed.copy(problem.u.vector)
-                problem.u.vector.axpy(r, u_committed)
-                problem.u.vector.axpy(-r, u_previous)
-                problem.u.x.scatter_forward()
-                if interface is not None:      # an augmented law's multipliers likewise
-                    interface.extrapolate_multipliers(r)
-            ok, result, failure, updates = _solve_step(problem, solver, comm)
-            spent[0] += result.iterations
-            spent[1] += result.linear_iterations
-            if ok:
-                # Re-evaluate at the converged iterate so the trial history matches it.
-                problem.F(None, solver.x, problem.b)
-                if interface is not None:
-                    interface.commit()
-                if predictor == "secant":
-                    if u_previous is None:
-                        u_previous = u_committed.duplicate()
-                    u_committed.copy(u_previous)
-                    lam_previous = lam_committed
-                problem.u.vector.copy(u_committed)
-                lam_committed = lam
-                step += 1
-                inc = Increment(
-                    step=step, load_factor=lam, target=target, iterations=result.iterations,
-                    residual=result.residuals[-1] if result.residuals else float("nan"),
-                    residuals=list(result.residuals),
-                    applied_force=problem.current_applied_force(),
-                    cutbacks=cutbacks, wall_time=time.perf_counter() - t_start,
-                    linear_solver=solver.linear_solver, newton_total=spent[0],
-                    linear_iterations=result.linear_iterations, linear_total=spent[1],
-                    failed_attempts=spent[2], augmentations=updates)
-                spent = [0, 0, 0]
-                if interface is not None:
-                    s = interface.summary()
-                    inc.n_points, inc.n_active, inc.n_slipping = (s.n_points, s.n_contact,
-                                                                  s.n_slipping)
-                    inc.contact_force, inc.real_area = s.contact_force, s.real_area
-                    inc.dissipation = s.dissipation
-                    inc.n_beyond_validity = s.n_beyond_validity
-                if checkpoint is not None:   # written after the caller's loop body
-                    saved = CheckpointState(
-                        step=step, index=i, delta=delta * max_growth if cutbacks else delta,
-                        cutbacks=cutbacks, load_factor=lam, lam_previous=lam_previous,
-                        u_previous=None if u_previous is None else u_previous.getArray().copy(),
-                        factors=factors)
-                if verbose:
-                    _print_increment(inc)
-                if inc.n_beyond_validity and validity != "ignore":
-                    _validity_guard(inc, validity)
+    stepper = _Stepper(problem, solver, list(factors), min_increment=min_increment,
+                       max_growth=max_growth, verbose=verbose, validity=validity,
+                       predictor=predictor, friction_check=friction_check)
+    yield from stepper.run(checkpoint=checkpoint, resume=resume, outputs=outputs,
+                           max_steps=max_steps)
+
+
+class _Stepper:
+    """The state of one load path: the committed and previous converged states, the counters
+    of the current step; :meth:`run` is the generator behind :func:`load_path`.
+
+    Each attempt follows the interface lifecycle (``ContactInterface``): begin_increment,
+    predict, Newton solve(s) with ``accept`` after each converged one, then commit or revert.
+    """
+
+    def __init__(self, problem, solver, factors, *, min_increment, max_growth, verbose,
+                 validity, predictor, friction_check):
+        self.problem, self.solver, self.factors = problem, solver, factors
+        self.comm, self.interface = problem.comm, problem.interface
+        self.min_increment, self.max_growth = min_increment, max_growth
+        self.verbose, self.validity = verbose, validity
+        self.predictor, self.friction_check = predictor, friction_check
+        self.u_committed = None
+        self.lam_committed = problem.load_factor
+        self.u_previous, self.lam_previous = None, None  # the converged state before u_committed
+        self.step = 0
+        self.spent = [0, 0, 0]  # Newton its, linear its, failed attempts since the last step
+
+    def run(self, *, checkpoint, resume, outputs, max_steps) -> Iterator[Increment]:
+        problem = self.problem
+        restored = None
+        if resume is not None:
+            restored = read_checkpoint(resume, problem, self.factors, outputs)
+        sig = None if checkpoint is None else checkpoint_signature(problem)
+        _check_initial_guess(problem)
+        self.u_committed = problem.solution_vector().copy()
+        self.lam_committed = problem.load_factor
+        start_index = 0
+        if restored is not None:
+            self.step, start_index = restored.step, restored.index
+            self.lam_previous = restored.lam_previous
+            if restored.u_previous is not None:
+                self.u_previous = self.u_committed.duplicate()
+                self.u_previous.setArray(restored.u_previous)
+        done = 0
+        for i, target in enumerate(self.factors):
+            if i < start_index:
+                continue
+            target = check_scalar(f"load factor {i} of the load path", target)
+            delta, cutbacks = target - self.lam_committed, 0
+            if restored is not None and i == restored.index:
+                delta, cutbacks = restored.delta, restored.cutbacks
+            t_start = time.perf_counter()
+            while abs(target - self.lam_committed) > 1e-14 * max(1.0, abs(target)):
+                if abs(delta) > abs(target - self.lam_committed):
+                    delta = target - self.lam_committed
+                lam = self.lam_committed + delta
+                ok, result, failure, updates = self._attempt(lam)
+                if not ok:
+                    delta, cutbacks = self._failed(lam, target, result, failure, delta,
+                                                   cutbacks)
+                    continue
+                inc, saved = self._converged(lam, target, i, result, updates, delta, cutbacks,
+                                             time.perf_counter() - t_start, checkpoint)
                 yield inc
                 if checkpoint is not None:
                     write_checkpoint(checkpoint, problem, saved, sig, outputs)
-                _update_pairing(problem)
                 done += 1
                 if max_steps is not None and done >= max_steps:
                     return
                 t_start = time.perf_counter()
                 if cutbacks:
-                    delta *= max_growth
-                continue
-            # Failure to converge: revert to the committed state and halve the increment.
-            f_failed = problem.current_applied_force()     # the load the failed step asked for
-            spent[2] += 1
-            u_committed.copy(problem.u.vector)
-            problem.u.x.scatter_forward()
-            problem.set_load_factor(lam_committed)
-            if interface is not None:
-                interface.revert()
-            if failure is not None:
-                why = f"{type(failure).__name__}: {failure}"
-            else:
-                why = f"{result.reason_name} after {result.iterations} its"
-            if friction_check and interface is not None and isinstance(interface.law,
-                                                                      FrictionBoundedLaw):
-                _check_friction_capacity(interface, f_failed, lam, target, lam_committed, why)
-            delta *= 0.5
-            cutbacks += 1
-            if abs(delta) < min_increment:
-                raise LoadStepError(
-                    f"load step to load factor {lam:.6g} (target {target:.6g}) failed ({why}); "
-                    f"cutback below the minimum increment {min_increment:g}; last converged load "
-                    f"factor {lam_committed:.6g} is committed", lam, lam_committed) from failure
-            if verbose:
-                PETSc.Sys.Print(f"  load {lam:.6g} failed ({why}): cutback to increment "
-                                f"{delta:.4g}")
+                    delta *= self.max_growth
+
+    def _attempt(self, lam: float):
+        """One attempt at load factor ``lam``: start the increment, predict, solve."""
+        problem, interface = self.problem, self.interface
+        problem.begin_increment()       # a sliding pairing re-pairs on the committed state
+        problem.set_load_factor(lam)
+        lam_n, lam_p = self.lam_committed, self.lam_previous
+        if (self.predictor == "secant" and self.u_previous is not None
+                and (lam - lam_n) * (lam_n - lam_p) > 0.0):
+            # u0 = u_n + r (u_n - u_{n-1}), r = (lam - lam_n) / (lam_n - lam_{n-1})
+            r = (lam - lam_n) / (lam_n - lam_p)
+            u = problem.solution_vector()
+            self.u_committed.copy(u)
+            u.axpy(r, self.u_committed)
+            u.axpy(-r, self.u_previous)
+            problem.scatter_solution()
+            if interface is not None:      # the multipliers of an augmented enforcement too
+                interface.predict(r)
+        ok, result, failure, updates = _solve_step(problem, self.solver, self.comm)
+        self.spent[0] += result.iterations
+        self.spent[1] += result.linear_iterations
+        return ok, result, failure, updates
+
+    def _converged(self, lam, target, index, result, updates, delta, cutbacks, wall, checkpoint):
+        """Commit the converged attempt; the Increment and the checkpoint state to write."""
+        problem, interface = self.problem, self.interface
+        if interface is not None:
+            interface.commit()
+        if self.predictor == "secant":
+            if self.u_previous is None:
+                self.u_previous = self.u_committed.duplicate()
+            self.u_committed.copy(self.u_previous)
+            self.lam_previous = self.lam_committed
+        problem.solution_vector().copy(self.u_committed)
+        self.lam_committed = lam
+        self.step += 1
+        inc = Increment(
+            step=self.step, load_factor=lam, target=target, iterations=result.iterations,
+            residual=result.residuals[-1] if result.residuals else float("nan"),
+            residuals=list(result.residuals), applied_force=problem.current_applied_force(),
+            cutbacks=cutbacks, wall_time=wall, linear_solver=self.solver.linear_solver,
+            newton_total=self.spent[0], linear_iterations=result.linear_iterations,
+            linear_total=self.spent[1], failed_attempts=self.spent[2], augmentations=updates)
+        self.spent = [0, 0, 0]
+        if interface is not None:
+            s = interface.summary()
+            inc.n_points, inc.n_active, inc.n_slipping = s.n_points, s.n_contact, s.n_slipping
+            inc.contact_force, inc.real_area = s.contact_force, s.real_area
+            inc.dissipation = s.dissipation
+            inc.n_beyond_validity = s.n_beyond_validity
+        saved = None
+        if checkpoint is not None:   # written after the caller's loop body
+            saved = CheckpointState(
+                step=self.step, index=index,
+                delta=delta * self.max_growth if cutbacks else delta, cutbacks=cutbacks,
+                load_factor=lam, lam_previous=self.lam_previous,
+                u_previous=None if self.u_previous is None else self.u_previous.getArray().copy(),
+                factors=self.factors)
+        if self.verbose:
+            _print_increment(inc)
+        if inc.n_beyond_validity and self.validity != "ignore":
+            _validity_guard(inc, self.validity)
+        return inc, saved
+
+    def _failed(self, lam, target, result, failure, delta, cutbacks):
+        """Revert a failed attempt and halve the increment (or give up with a LoadStepError)."""
+        problem, interface = self.problem, self.interface
+        f_failed = problem.current_applied_force()     # the load the failed step asked for
+        self.spent[2] += 1
+        self.u_committed.copy(problem.solution_vector())
+        problem.scatter_solution()
+        problem.set_load_factor(self.lam_committed)
+        if interface is not None:
+            interface.revert()
+        if failure is not None:
+            why = f"{type(failure).__name__}: {failure}"
+        else:
+            why = f"{result.reason_name} after {result.iterations} its"
+        if self.friction_check and interface is not None and isinstance(interface.law,
+                                                                        FrictionBoundedLaw):
+            _check_friction_capacity(interface, f_failed, lam, target, self.lam_committed, why)
+        delta *= 0.5
+        cutbacks += 1
+        if abs(delta) < self.min_increment:
+            raise LoadStepError(
+                f"load step to load factor {lam:.6g} (target {target:.6g}) failed ({why}); "
+                f"cutback below the minimum increment {self.min_increment:g}; last converged "
+                f"load factor {self.lam_committed:.6g} is committed", lam,
+                self.lam_committed) from failure
+        if self.verbose:
+            PETSc.Sys.Print(f"  load {lam:.6g} failed ({why}): cutback to increment "
+                            f"{delta:.4g}")
+        return delta, cutbacks
 
 
 def _check_friction_capacity(interface, f, lam, target, lam_committed, why) -> None:
@@ -451,8 +482,7 @@ def _check_friction_capacity(interface, f, lam, target, lam_committed, why) -> N
 
 def _check_initial_guess(problem: ContactProblem) -> None:
     """Refuse a non-finite starting displacement on every rank (collective)."""
-    x = problem.u.x.array[: problem.u.function_space.dofmap.index_map.size_local
-                          * problem.u.function_space.dofmap.index_map_bs]
+    x = problem.owned_solution_values()
     bad = np.flatnonzero(~np.isfinite(x))
     n_bad = problem.comm.allreduce(int(bad.size), op=MPI.SUM)
     if n_bad:
@@ -473,7 +503,7 @@ def _validity_guard(inc: Increment, policy: str) -> None:
            "value, i.e. real-area fraction above the model's limit, where a stiff continuation "
            "replaces the rough-surface model); pressures and stiffnesses there are not the "
            "model's. Lower the load, or use a law valid at higher load (e.g. the BEM-calibrated "
-           "law, rough_contact.bem)")
+           "law, rough_contact.micro.bem)")
     if policy == "error":
         raise ModelValidityError(msg + "; this increment is committed", inc.load_factor,
                                  inc.n_beyond_validity, inc.n_points)
@@ -481,31 +511,29 @@ def _validity_guard(inc: Increment, policy: str) -> None:
 
 
 def _solve_step(problem: ContactProblem, solver: SNESSolver, comm: MPI.Comm):
-    """Solve one load step: a Newton solve and, for an augmented-Lagrangian law
-    (``ContactInterface.augmentation()`` not None), Uzawa updates of its multipliers, each
-    followed by a Newton solve from the current iterate, until an update changes them by at
-    most the law's tolerance (then the last solve's trial state is the one to commit).
+    """Solve one load step: a Newton solve, then ``interface.accept`` at the converged iterate;
+    while an enforcement with multipliers updates them (``Acceptance.done`` False), another
+    Newton solve from the current iterate.
 
     Returns:
         (converged, SolveResult with iterations summed over the solves, the failure or None,
-        number of multiplier updates). More updates than the law's ``max_updates`` is a
-        failure (a ConvergenceError: the caller reverts, which also restores the multipliers,
-        and cuts back).
+        number of multiplier updates). More updates than the enforcement's ``max_updates`` is
+        a failure (a ConvergenceError: the caller reverts, which also restores the
+        multipliers, and cuts back).
     """
     interface = problem.interface
-    control = None if interface is None else interface.augmentation()
     ok, total, failure = _attempt(solver, comm)
     updates = 0
-    while ok and control is not None:
-        interface.evaluate(problem.u)    # the law at the converged iterate (cached if there)
-        rel, updated = interface.augment(control.tolerance)
-        if not updated:
+    while ok and interface is not None:
+        acceptance = interface.accept(problem.u)
+        if acceptance.done:
             break
-        if updates >= control.max_updates:
+        enforcement = interface.enforcement
+        if updates >= enforcement.max_updates:
             failure = ConvergenceError(
-                f"augmented Lagrangian: the multipliers still moved by {rel:.3g} of the largest "
-                f"traction after {updates} updates (augmentation_tolerance "
-                f"{control.tolerance:g}, max_augmentations {control.max_updates}); a stiffer "
+                f"augmented Lagrangian: the multipliers still moved by {acceptance.change:.3g} "
+                f"of the largest traction after {updates} updates (augmentation tolerance "
+                f"{enforcement.tolerance:g}, max_updates {enforcement.max_updates}); a stiffer "
                 "penalty needs fewer updates")
             return False, total, failure, updates
         updates += 1

@@ -140,7 +140,7 @@ def cycle_summary(times, program: LoadProgram, displacement, force, dissipation)
         equal to the loop energy in a steady cycle), ``secant_stiffness`` ((F_max - F_min) /
         (u_max - u_min) over the cycle [N/mm]).
     """
-    from rough_contact.plotting import loop_energies
+    from rough_contact.io.plotting import loop_energies
 
     t = np.asarray(times, dtype=float)
     u = np.asarray(displacement, dtype=float)

@@ -234,7 +234,7 @@ class SNESSolver:
         self.snes.setOptionsPrefix(prefix)
         # Never hand u.vector to SNES: the callbacks copy x into u, and line-search work
         # vectors would overwrite the iterate (docs/design.md, "Stack pitfalls").
-        self.x = problem.u.vector.copy()
+        self.x = problem.solution_vector().copy()
         self.snes.setFunction(problem.F, problem.b)
         self.snes.setJacobian(problem.J, problem.A)
         self._A = problem.A        # a re-pairing may replace it (problem.rebuild_matrices)
@@ -292,7 +292,7 @@ class SNESSolver:
         if self.problem.A is not self._A:          # new pattern after a re-pairing
             self.snes.setJacobian(self.problem.J, self.problem.A)
             self._A = self.problem.A
-        self.problem.u.vector.copy(self.x)
+        self.problem.solution_vector().copy(self.x)
         if self.problem.interface is not None:
             self.problem.interface.begin_solve()   # no Newton-step memory from the last solve
         if self._auto_atol:

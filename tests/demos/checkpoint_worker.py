@@ -16,8 +16,8 @@ from mpi4py import MPI
 sys.path.insert(0, str(Path(__file__).parents[1] / "fem"))
 import test_checkpoint  # noqa: E402  (the checkpoint test's model, with a longer program)
 
+from rough_contact.io import ResultWriter  # noqa: E402
 from rough_contact.solver.loading import load_path  # noqa: E402
-from rough_contact.solver.output import ResultWriter  # noqa: E402
 from rough_contact.solver.program import preload_then_cyclic  # noqa: E402
 
 PROGRAM = test_checkpoint.PROGRAM = preload_then_cyclic(preload_steps=2, cycles=2,

@@ -50,7 +50,7 @@ def _same_output(run, ref, n_steps):
     sys.path.insert(0, str(Path(__file__).parents[1] / "fem"))
     from test_checkpoint import _csv, _xdmf_steps
 
-    from rough_contact.fem.interface_output import read_interface_results
+    from rough_contact.io import read_interface_results
 
     got, want = _csv(run / "history.csv"), _csv(ref / "history.csv")
     assert [r["step"] for r in got] == list(range(1, n_steps + 1))

@@ -1,4 +1,4 @@
-"""Augmented-Lagrangian (Uzawa) penalty contact, ``SoftplusPenalty(augmented=True)``: exact
+"""Augmented-Lagrangian (Uzawa) enforcement of a penalty law, ``AugmentedLagrangian()``: exact
 stick and exact contact against a clamped elastic block solved without any contact code,
 penalty independence on the Coulomb punch, and the multipliers restored after a failed step.
 Serial and on 2 ranks (every figure compared is partition-independent)."""
@@ -17,6 +17,7 @@ from dolfinx import fem
 
 from rough_contact.fem.contact import ContactInterface
 from rough_contact.fem.problem import ContactProblem, Material, SurfaceLoad
+from rough_contact.interface.enforcement import AugmentedLagrangian, Penalty
 from rough_contact.interface.penalty import SoftplusPenalty
 from rough_contact.scenes import flat_punch
 from rough_contact.scenes.meshes.blocks import block_on_plane
@@ -53,12 +54,13 @@ def _clamped(scene, V):
 
 
 def _on_plane(scene, V, augmented, k, **kwargs):
-    law = SoftplusPenalty(k_normal=k, width=1e-6 * P / k, k_tangential=k, friction=MU,
-                          augmented=augmented, **kwargs)
+    law = SoftplusPenalty(k_normal=k, width=1e-6 * P / k, k_tangential=k, friction=MU)
+    enforcement = AugmentedLagrangian(**kwargs) if augmented else Penalty()
     order = V.ufl_element().degree()
     if order == 1:
         ci = ContactInterface(V, scene.facet_tags, scene.tag("contact"), law=law,
-                              rigid_plane=scene.rigid_plane, quadrature="vertex")
+                              rigid_plane=scene.rigid_plane, quadrature="vertex",
+                              enforcement=enforcement)
     else:
         # 6 Gauss points per P2 facet: over-constrained where stick ends (the interface warns);
         # this block sticks everywhere, so the exact solution is still reached
@@ -66,7 +68,8 @@ def _on_plane(scene, V, augmented, k, **kwargs):
                     else contextlib.nullcontext())
         with expected:
             ci = ContactInterface(V, scene.facet_tags, scene.tag("contact"), law=law,
-                                  rigid_plane=scene.rigid_plane, quadrature_degree=2 * order)
+                                  rigid_plane=scene.rigid_plane, quadrature_degree=2 * order,
+                                  enforcement=enforcement)
     problem = ContactProblem(V, Material(E, NU), [], _load(scene), facet_tags=scene.facet_tags,
                              interface=ci)
     solver = SNESSolver(problem, prefix="aug_plane_")
@@ -100,7 +103,7 @@ def test_exact_stick_and_contact_equal_the_clamped_block(order):
     for augmented in (False, True):
         # the tolerance must stay above the Newton solves' own accuracy (rtol 1e-9 of the
         # step's first residual): the multiplier changes stall at about 1e-9
-        extra = dict(augmentation_tolerance=1e-7, max_augmentations=60) if augmented else {}
+        extra = dict(tolerance=1e-7, max_updates=60) if augmented else {}
         problem, solver, ci = _on_plane(scene, V, augmented, k, **extra)
         incs = list(load_path(problem, solver, [1.0], verbose=False))
         assert incs[-1].n_slipping == 0 and incs[-1].n_active == incs[-1].n_points
@@ -118,10 +121,11 @@ PUNCH = (10.0, 1.2)   # (mesh size, contact size) [mm]
 
 
 def _punch(k, augmented, mu=0.5, predictor="secant"):
-    law = SoftplusPenalty(k_normal=k, width=1e-2 * 2.5 / k, k_tangential=k, friction=mu,
-                          augmented=augmented, augmentation_tolerance=1e-4)
+    law = SoftplusPenalty(k_normal=k, width=1e-2 * 2.5 / k, k_tangential=k, friction=mu)
+    enforcement = AugmentedLagrangian(tolerance=1e-4) if augmented else Penalty()
     m = flat_punch.build(MPI.COMM_WORLD, mesh_size=PUNCH[0], contact_size=PUNCH[1], order=1,
-                         load_half_width=10.0, law=law, steps=N_LOAD, quadrature="vertex")
+                         load_half_width=10.0, law=law, steps=N_LOAD, quadrature="vertex",
+                         enforcement=enforcement)
     factors = load_unload_factors(N_LOAD, N_LOAD - 1, final_factor=1.0 / N_LOAD)
     incs = list(load_path(m.problem, m.solver, factors, verbose=False, predictor=predictor))
     m.solver.destroy()
@@ -158,11 +162,11 @@ def test_failed_updates_restore_the_multipliers():
     """More multiplier updates than allowed is a convergence failure: the step is reverted
     (multipliers included) and cut back, and finally a LoadStepError names the cause."""
     problem, solver, ci = _on_plane(*_block(1), True, 0.1 * E / H,
-                                    augmentation_tolerance=1e-12, max_augmentations=2)
-    before = ci.history.committed.multiplier.copy()
+                                    tolerance=1e-12, max_updates=2)
+    before = ci.history.multipliers.copy()
     with pytest.raises(LoadStepError, match="augmented Lagrangian: the multipliers still moved"):
         list(load_path(problem, solver, [1.0], verbose=False, min_increment=0.3))
-    np.testing.assert_array_equal(ci.history.committed.multiplier, before)
+    np.testing.assert_array_equal(ci.history.multipliers, before)
     solver.destroy()
 
 
@@ -176,7 +180,7 @@ def test_checkpoint_keeps_the_multipliers(tmp_path):
     scene, V = _block(1)
     factors = [0.4, 0.8, 1.0, 0.6, 0.9]
     k = 50.0 * E / 0.25
-    opts = dict(augmentation_tolerance=1e-2, max_augmentations=60)
+    opts = dict(tolerance=1e-2, max_updates=60)
 
     problem, solver, _ = _on_plane(scene, V, True, k, **opts)
     ref = list(load_path(problem, solver, factors, verbose=False))
@@ -210,16 +214,16 @@ def test_overconstraining_gauss_rule_warns(order):
     points against 0.5 nodes; P2: 3 against 2) lock: the interface warns and names the
     remedy. The vertex rule (P1), a 1-point rule (P2) and a plain penalty do not warn."""
     scene, V = _block(order)
-    law = SoftplusPenalty(k_normal=1e5, width=1e-9, k_tangential=1e5, friction=MU,
-                          augmented=True)
+    law = SoftplusPenalty(k_normal=1e5, width=1e-9, k_tangential=1e5, friction=MU)
     remedy = "use quadrature='vertex'" if order == 1 else "at most 2 point"
     with pytest.warns(UserWarning, match=remedy):
         ContactInterface(V, scene.facet_tags, scene.tag("contact"), law=law,
-                         rigid_plane=scene.rigid_plane, quadrature_degree=2)
+                         rigid_plane=scene.rigid_plane, quadrature_degree=2,
+                         enforcement=AugmentedLagrangian())
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         ContactInterface(V, scene.facet_tags, scene.tag("contact"), law=law,
-                         rigid_plane=scene.rigid_plane,
+                         rigid_plane=scene.rigid_plane, enforcement=AugmentedLagrangian(),
                          **({"quadrature": "vertex"} if order == 1 else {"quadrature_degree": 1}))
         ContactInterface(V, scene.facet_tags, scene.tag("contact"),
                          law=SoftplusPenalty(k_normal=1e5, width=1e-9),

@@ -20,14 +20,13 @@ from petsc4py import PETSc
 
 from dolfinx import fem
 from rough_contact.fem.contact import ContactInterface
-from rough_contact.fem.interface_output import read_interface_results
 from rough_contact.fem.problem import (ContactProblem, Material, PrescribedDisplacement,
                                        SurfaceLoad)
+from rough_contact.io import ResultWriter, read_interface_results
 from rough_contact.scenes import flat_punch
 from rough_contact.scenes.meshes.blocks import two_blocks
 from rough_contact.solver.checkpoint import CheckpointError
 from rough_contact.solver.loading import load_path
-from rough_contact.solver.output import ResultWriter
 from rough_contact.solver.program import preload_then_cyclic
 from rough_contact.solver.snes import SNESSolver
 from rough_contact.scenes.defaults import SEATING_STIFFNESS

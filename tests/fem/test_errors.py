@@ -15,6 +15,8 @@ import numpy as np
 import pytest
 from mpi4py import MPI
 
+import dolfinx.cpp
+import ufl
 from dolfinx import fem
 from rough_contact.fem.collective import raise_on_all_ranks
 from rough_contact.fem.contact import ContactInterface
@@ -141,21 +143,31 @@ def test_non_finite_jump_is_a_convergence_error_before_the_law_is_called():
     assert ci.comm.allreduce(law.calls, op=MPI.SUM) >= 1
 
 
-def test_evaluation_cache_and_law_calls():
-    """One law call per new displacement; residual + Jacobian at the same u share it."""
+def test_lifecycle_law_calls():
+    """The lifecycle decides when the law runs, no cache: every evaluate calls the law once;
+    the residual and the Jacobian assembled after it use that evaluation (no further call);
+    after a revert nothing is left to assemble from until the next evaluation."""
     law = _Counting(SoftplusPenalty(1e4, 1e-3, k_tangential=5e3, friction=0.3))
     V, ci = _interface(law)
     u = fem.Function(V)
     interpolate_bodies(u, lambda x, up: smooth_field(x, up, 1e-3))
     ci.evaluate(u)
-    ci.evaluate(u)
-    ci.evaluate(u.vector)
     assert law.calls == 1
-    ci.commit()  # new committed state: the old evaluation is never reused
-    ci.evaluate(u)
+    b = dolfinx.cpp.la.petsc.create_vector(V.dofmap.index_map, 3)
+    ci.assemble_residual(b)
+    mass = fem.form(ufl.inner(ufl.TrialFunction(V), ufl.TestFunction(V)) * ufl.dx)
+    A = ci.create_matrix(mass)
+    ci.assemble_jacobian(A)
+    A.assemble()
+    assert law.calls == 1
+    ci.evaluate(u.vector)             # the same u again: the law runs again
     assert law.calls == 2
+    assert ci.accept(u).done and law.calls == 3   # accept evaluates at the converged iterate
+    ci.commit()
+    ci.contact_force()                # queries read the last evaluation, also after a commit
     ci.revert()
-    ci.evaluate(u)
+    with pytest.raises(ValueError, match="not been evaluated"):
+        ci.assemble_residual(b)
     assert law.calls == 3
 
 

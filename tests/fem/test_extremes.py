@@ -40,8 +40,8 @@ from rough_contact.scenes import flat_punch as demo  # noqa: E402
 from petsc4py import PETSc  # noqa: E402
 
 from rough_contact.interface.contract import ConvergenceError  # noqa: E402
+from rough_contact.io import ResultWriter  # noqa: E402
 from rough_contact.solver.loading import LoadStepError, load_path, load_unload_factors  # noqa: E402
-from rough_contact.solver.output import ResultWriter  # noqa: E402
 
 # Coarse scene: ~1 s per Newton solve sequence on one core.
 MESH = dict(mesh_size=20.0, contact_size=2.5, order=1, load_half_width=2.5)
@@ -212,7 +212,7 @@ class Scene:
                     if psi is None:
                         normal = NormalLaw.elastic(surface, E_star, rtol=NORMAL_RTOL)
                     else:
-                        from rough_contact.asperity import AsperityMaterial
+                        from rough_contact.micro.asperity import AsperityMaterial
 
                         mat = AsperityMaterial(E_star=E_star, nu=demo.NU,
                                                **dict(demo.PLASTIC, psi=psi))
@@ -301,7 +301,7 @@ class Scene:
                 assert inc.n_beyond_validity == n_below     # the load stepping's own count
                 out.max_below_validity = max(out.max_below_validity, n_below)
                 out.n_points = inc.n_points
-                sp_new = interface.slip_stats().max_plastic_slip
+                sp_new = interface.summary().max_plastic_slip
                 bound += case.mu * abs(inc.contact_force[2]) * (sp_new + sp_old)
                 sp_old = sp_new
                 if case.forced_failure and inc.step == 2:

@@ -29,11 +29,12 @@ from dolfinx import fem
 from rough_contact.scenes.meshes.blocks import block_on_plane
 from rough_contact.scenes.meshes.flat_punch import flat_punch
 from rough_contact.fem.contact import ContactInterface
-from rough_contact.fem.interface_output import (
-    FACET_FIELD_NAMES, POINT_FIELD_NAMES, InterfaceWriter, OutputExistsError, facet_average,
-    facet_status, prepare_output_dir, pseudo_time, read_interface_results)
 from rough_contact.fem.problem import ContactProblem, Material, SurfaceLoad
 from rough_contact.interface.penalty import LinearPenalty
+from rough_contact.io.files import OutputExistsError, prepare_output_dir
+from rough_contact.io.interface_output import (
+    FACET_FIELD_NAMES, POINT_FIELD_NAMES, InterfaceWriter, facet_average, facet_status,
+    pseudo_time, read_interface_results)
 from rough_contact.solver.loading import load_path
 from rough_contact.solver.snes import SNESSolver
 from rough_contact.scenes.defaults import SEATING_STIFFNESS
@@ -507,12 +508,12 @@ def _series(comm, path, times):
 
 
 def test_time_series_cut_back_and_continued():
-    """A restart's trimming (output.truncate_time_series): a DOLFINx XDMF series of 4 steps cut
+    """A restart's trimming (io.results.truncate_time_series): a DOLFINx XDMF series of 4 steps cut
     back to 2 keeps those 2 (XML and data), drops the others' datasets, and DOLFINx can then
     append the same time values again (it refuses a dataset that exists)."""
     from dolfinx.io import XDMFFile
 
-    from rough_contact.solver.output import truncate_time_series
+    from rough_contact.io.results import truncate_time_series
 
     comm = MPI.COMM_WORLD
     folder = comm.bcast(tempfile.mkdtemp() if comm.rank == 0 else None, root=0)
@@ -542,7 +543,7 @@ def test_time_series_cut_back_and_continued():
 def test_damaged_time_series_moved_aside():
     """An HDF5 file a kill damaged in the middle of its write cannot be continued: it is moved
     aside with a warning and the caller is told to start the series afresh."""
-    from rough_contact.solver.output import truncate_time_series
+    from rough_contact.io.results import truncate_time_series
 
     if MPI.COMM_WORLD.rank != 0:
         return

@@ -24,7 +24,7 @@ from rough_contact.fem.contact import ContactInterface
 from rough_contact.fem.problem import (ContactProblem, Material, PrescribedDisplacement,
                                        SurfaceLoad)
 from rough_contact.interface.penalty import SoftplusPenalty
-from rough_contact.plotting import loop_energies
+from rough_contact.io.plotting import loop_energies
 from rough_contact.scenes.meshes.blocks import two_blocks
 from rough_contact.solver.loading import load_path
 from rough_contact.solver.program import cycle_index, cycle_summary, preload_then_cyclic

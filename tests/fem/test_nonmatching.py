@@ -27,9 +27,9 @@ from petsc4py import PETSc
 import dolfinx
 from dolfinx import fem
 from rough_contact.fem.contact import ContactInterface
-from rough_contact.fem.interface_output import facet_output
 from rough_contact.fem.problem import ContactProblem, Material, SurfaceLoad
 from rough_contact.interface.penalty import LinearPenalty, SoftplusPenalty
+from rough_contact.io.interface_output import facet_output
 from rough_contact.scenes.meshes.blocks import separate_blocks
 from rough_contact.solver.snes import SNESSolver
 
@@ -154,14 +154,17 @@ def _figures(comm, pairing, order=2, fd=False):
                           cells=upper)
         u.x.array[:] += shift.x.array
         u.x.scatter_forward()
-        ci.update_pairing(u)
+        ci.commit()          # a converged increment: the next one re-pairs
+        ci.begin_increment(u)
         assert ci.comm.allreduce(ci.n_repairs, op=MPI.MAX) == 1
     b = dolfinx.cpp.la.petsc.create_vector(V.dofmap.index_map, 3)
     b.set(0.0)
-    ci.assemble_residual(u, b)
+    ci.evaluate(u)
+    ci.assemble_residual(b)
     mass = fem.form(ufl.inner(ufl.TrialFunction(V), ufl.TestFunction(V)) * ufl.dx)
     A = ci.create_matrix(mass)
-    ci.assemble_jacobian(u, A)
+    ci.evaluate(u)
+    ci.assemble_jacobian(A)
     A.assemble()
     figs = np.concatenate([ci.contact_force(), [b.norm(), A.norm(), ci.real_contact_area(),
                                                 ci.nominal_area()]])
@@ -181,7 +184,8 @@ def _figures(comm, pairing, order=2, fd=False):
             xs.axpy(sgn * eps, d)
             bs = b.duplicate()
             bs.set(0.0)
-            ci.assemble_residual(xs, bs)
+            ci.evaluate(xs)
+            ci.assemble_residual(bs)
             res.append(bs)
         fd_vec = res[0].copy()
         fd_vec.axpy(-1.0, res[1])

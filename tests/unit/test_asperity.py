@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 from scipy import special
 
-from rough_contact import asperity as asp
-from rough_contact.asperity import AsperityMaterial
+from rough_contact.micro import asperity as asp
+from rough_contact.micro.asperity import AsperityMaterial
 
 
 def test_abramowitz_stegun_approximations_within_stated_error():

@@ -1,4 +1,4 @@
-"""Tests of the boundary-element normal law (rough_contact.bem) and the spectrum fit.
+"""Tests of the boundary-element normal law (rough_contact.micro.bem) and the spectrum fit.
 
 References we did not write: Westergaard's wavy surface (closed forms below, derived in
 docs/bem.md and checked there against Tamaas), Hertz's circular contact, Mindlin's stick ratio,
@@ -16,11 +16,11 @@ import warnings
 import numpy as np
 import pytest
 
-from rough_contact import bem
-from rough_contact.bem import (BackendUnavailableError, HalfSpace, HeightMapWarning, NumpySolver,
+from rough_contact.micro import bem
+from rough_contact.micro.bem import (BackendUnavailableError, HalfSpace, HeightMapWarning, NumpySolver,
                                _post_process)
 from rough_contact.interface.normal import NormalLaw
-from rough_contact.spectrum import SpectrumShape, fit_spectrum
+from rough_contact.surface.spectrum import SpectrumShape, fit_spectrum
 from rough_contact.surface import SpectralMoments, moments_from_height_map
 
 HAVE_TAMAAS = "tamaas" in bem.available_backends()
@@ -257,7 +257,7 @@ def test_tangential_from_bem(rough_law):
     assert abs(c[0] / c[1] - 1) < 0.05
 
 
-@pytest.mark.filterwarnings("ignore::rough_contact.bem.HeightMapWarning")   # coarse on purpose
+@pytest.mark.filterwarnings("ignore::rough_contact.micro.bem.HeightMapWarning")   # coarse on purpose
 def test_realisations_band(tmp_path):
     """Several realisations: averaged at equal separation, scatter reported, cache per map."""
     m = iso_moments()
@@ -463,7 +463,7 @@ def test_spectrum_bad_input():
 
 
 def test_pure_layer():
-    code = ("import sys, rough_contact.bem, rough_contact.spectrum\n"
+    code = ("import sys, rough_contact.micro.bem, rough_contact.surface.spectrum\n"
             "bad = {'dolfinx', 'ufl', 'petsc4py', 'basix', 'mpi4py', 'gmsh', 'tamaas'} & "
             "set(sys.modules)\n"
             "assert not bad, bad\n")

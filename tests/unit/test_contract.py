@@ -179,7 +179,7 @@ def test_friction_evaluate_matches_return_map_and_writes_in_place(friction, kt_y
     dkt = -kt * 1e3
     p, kn = rng.uniform(0.1, 5.0, m), rng.uniform(1e3, 1e5, m)
     kap, path = rng.uniform(0, 1e-3, (m, 2)), rng.uniform(0, 1e-3, m)
-    ref = friction.return_map(e, kt, dkt, p, kn, kap, path)
+    ref = friction.evaluate(FrictionInput.from_pairs(e, kt, dkt, p, kn, kap, path))
     pts = FrictionInput(e[:, 0].copy(), e[:, 1].copy(), kt[:, 0].copy(), kt[:, 1].copy(),
                         dkt[:, 0].copy(), dkt[:, 1].copy(), p, kn, kap[:, 0].copy(),
                         kap[:, 1].copy(), path)
@@ -280,23 +280,18 @@ def test_newton_tangent_laws(gw_normal):
     assert memo.shape == (2, 2)
 
 
-def test_augmented_lagrangian_laws(gw_normal):
-    """Only the Coulomb penalty declares the augmented-Lagrangian capability, and only an
-    ``augmented=True`` one asks for the multiplier loop (a plain law returns no control)."""
-    from dataclasses import replace
-
-    from rough_contact.interface.contract import AugmentationControl, AugmentedLagrangianLaw
-    from rough_contact.interface.state import AugmentedState
+def test_multiplier_laws(gw_normal):
+    """Only the Coulomb penalty declares the multiplier capability; the law it returns for
+    given multipliers follows the contract."""
+    from rough_contact.interface.contract import MultiplierLaw
 
     laws = built_in_laws(gw_normal)
-    assert [k for k, law in laws.items() if isinstance(law, AugmentedLagrangianLaw)] == \
+    assert [k for k, law in laws.items() if isinstance(law, MultiplierLaw)] == \
         ["softplus_penalty"]
-    assert laws["softplus_penalty"].augmentation() is None
-    law = replace(laws["softplus_penalty"], augmented=True)
-    assert isinstance(law.augmentation(), AugmentationControl)
-    state = law.initial_state(3)
-    assert isinstance(state, AugmentedState) and state.multiplier.shape == (3, 3)
+    plain = laws["softplus_penalty"]
+    state = plain.initial_state(3)
+    law = plain.with_multipliers(np.full((3, 3), 0.1))
     res = law.evaluate(np.array([[-1e-3, 2e-3, 0.0]] * 3), state)
     res.check(3)
-    new, change = law.augment(state, res)
-    assert len(new) == 3 and change.shape == (3,) and np.all(change > 0.0)
+    assert np.all(res.traction != plain.evaluate(np.array([[-1e-3, 2e-3, 0.0]] * 3),
+                                                 state).traction)

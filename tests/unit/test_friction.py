@@ -6,6 +6,7 @@ import pytest
 from scipy.optimize import brentq
 
 from rough_contact.interface.friction import (
+    FrictionInput,
     IsotropicSlipHardening,
     OrthotropicSlipHardening,
     continuum_tangent,
@@ -31,8 +32,9 @@ class Point:
 
     def step(self, s):
         s = np.atleast_2d(np.asarray(s, float))
-        r = self.law.return_map(s - self.sp, self.kt, np.zeros_like(self.kt), self.p,
-                                np.zeros_like(self.p), self.kap, self.path)
+        r = self.law.evaluate(FrictionInput.from_pairs(
+            s - self.sp, self.kt, np.zeros_like(self.kt), self.p, np.zeros_like(self.p), self.kap,
+            self.path))
         self.sp = self.sp + r.plastic_increment
         self.kap = self.kap + np.abs(r.plastic_increment)
         self.path = self.path + np.hypot(*r.plastic_increment.T)
@@ -166,7 +168,7 @@ def test_isotropic_zero_deviation_and_radial_vs_general():
     path = rng.uniform(0, 0.005, m)
     p = rng.uniform(0.1, 3, m)
     kt = np.full((m, 2), 3000.0)
-    r = iso.return_map(e, kt, np.zeros_like(kt), p, np.zeros(m), kap, path)
+    r = iso.evaluate(FrictionInput.from_pairs(e, kt, np.zeros_like(kt), p, np.zeros(m), kap, path))
     s = r.slipping
     assert s.sum() > 100
     cross = r.traction[s, 0] * r.plastic_increment[s, 1] - r.traction[s, 1] * r.plastic_increment[s, 0]
@@ -174,7 +176,8 @@ def test_isotropic_zero_deviation_and_radial_vs_general():
     # radial closed form (kTx == kTy) equals the general scalar map (kTx != kTy by 1 ulp-ish)
     kt2 = kt.copy()
     kt2[:, 1] *= 1 + 1e-13
-    r2 = iso.return_map(e, kt2, np.zeros_like(kt), p, np.zeros(m), kap, path)
+    r2 = iso.evaluate(FrictionInput.from_pairs(e, kt2, np.zeros_like(kt), p, np.zeros(m), kap,
+                                               path))
     np.testing.assert_allclose(r2.traction, r.traction, rtol=1e-9, atol=1e-14)
     np.testing.assert_allclose(r2.tangent, r.tangent, rtol=1e-8, atol=1e-6)
 
@@ -224,7 +227,8 @@ def _eval(law, z, kap, path, c, l=1e-3, p0=5.0):
     p = p0 * np.exp(-g / l)
     kn = p / l
     dk = -kn / l
-    return law.return_map(z[:, 1:], c * kn[:, None], c * dk[:, None], p, kn, kap, path)
+    return law.evaluate(FrictionInput.from_pairs(z[:, 1:], c * kn[:, None], c * dk[:, None], p,
+                                                 kn, kap, path))
 
 
 LAWS = {
@@ -303,12 +307,14 @@ def test_continuum_tangent_is_small_increment_limit():
         mu[:, 0], mu[:, 1], th)[:, None]
     for delta, tol in [(1e-4, 2e-3), (1e-6, 2e-5)]:
         e = t_on * (1 + delta) / kt
-        r = law.return_map(e, kt, np.zeros_like(kt), p, np.zeros(m), kap, np.zeros(m))
+        r = law.evaluate(FrictionInput.from_pairs(e, kt, np.zeros_like(kt), p, np.zeros(m), kap,
+                                                  np.zeros(m)))
         assert r.slipping.all()
         mu1, dmu1 = law.coefficients(kap + np.abs(r.plastic_increment))
         Dc = continuum_tangent(r.traction, p, np.full(m, 1e4), kt, mu1, dmu1, law.potential_axes)
         # compare tangential rows w.r.t. slips (normal coupling: use kn = 1e4 in both)
-        r_kn = law.return_map(e, kt, np.zeros_like(kt), p, np.full(m, 1e4), kap, np.zeros(m))
+        r_kn = law.evaluate(FrictionInput.from_pairs(e, kt, np.zeros_like(kt), p, np.full(m, 1e4),
+                                                     kap, np.zeros(m)))
         diff = np.abs(Dc[:, 1:, :] - r_kn.tangent).max(axis=(1, 2)) / np.abs(Dc).max(axis=(1, 2))
         assert diff.max() <= tol, (delta, diff.max())
 
@@ -332,7 +338,7 @@ def test_extreme_parameters_stay_finite():
                         kt = np.asarray(c) * kn[:, None]
                         kap = rng.uniform(0, 1e-2, (m, 2))
                         path = kap.sum(axis=1)
-                        r = law.return_map(e, kt, -kt, p, kn, kap, path)
+                        r = law.evaluate(FrictionInput.from_pairs(e, kt, -kt, p, kn, kap, path))
                         for arr in (r.traction, r.tangent, r.plastic_increment):
                             assert np.isfinite(arr).all(), (mu_m, nu_ratio, n, c)
                         if isinstance(law, OrthotropicSlipHardening):
@@ -380,11 +386,11 @@ def test_bad_return_map_inputs():
                      ("accumulated_slip", np.zeros((m + 1, 2))), ("slip_path", np.zeros((m, 2))),
                      ("kn", np.ones(m + 1)), ("dkt", np.zeros((2, m)))]:
         with pytest.raises(ValueError, match=key):
-            law.return_map(**{**good, key: bad})
+            law.evaluate(FrictionInput.from_pairs(**{**good, key: bad}))
     with pytest.raises(ValueError, match="pressure"):
-        law.return_map(**{**good, "pressure": -np.ones(m)})
+        law.evaluate(FrictionInput.from_pairs(**{**good, "pressure": -np.ones(m)}))
     with pytest.raises(ValueError, match="kt"):
-        law.return_map(**{**good, "kt": np.zeros((m, 2))})
+        law.evaluate(FrictionInput.from_pairs(**{**good, "kt": np.zeros((m, 2))}))
 
 
 def test_nonconvergence_is_reported(monkeypatch):
@@ -395,5 +401,6 @@ def test_nonconvergence_is_reported(monkeypatch):
     m = 10
     e = np.column_stack([np.linspace(1e-3, 2e-3, m), np.linspace(-1e-3, 1e-3, m)])
     with pytest.raises(fr.ReturnMappingError, match=r"did not converge at \d+ of 10 slipping points"):
-        law.return_map(e, np.full((m, 2), 1e4), np.zeros((m, 2)), np.ones(m), np.zeros(m),
-                       np.zeros((m, 2)), np.zeros(m))
+        law.evaluate(FrictionInput.from_pairs(
+            e, np.full((m, 2), 1e4), np.zeros((m, 2)), np.ones(m), np.zeros(m),
+            np.zeros((m, 2)), np.zeros(m)))

@@ -336,7 +336,7 @@ def test_from_model_validation():
 
 
 # ----------------------------------------------------------------------------------------------
-# against the population sums (rough_contact.population)
+# against the population sums (rough_contact.micro.population)
 # ----------------------------------------------------------------------------------------------
 
 
@@ -356,7 +356,7 @@ def _check_against_population(law, direct, rtol, n=40):
 
 
 def test_population_greenwood_williamson():
-    from rough_contact import population
+    from rough_contact.micro import population
     from rough_contact.surface import SpectralMoments
 
     surface = SpectralMoments(M00, M20, M02, M40, M04, unit="um")
@@ -369,7 +369,7 @@ def test_population_greenwood_williamson():
 
 
 def test_population_elastic():
-    from rough_contact import population
+    from rough_contact.micro import population
     from rough_contact.surface import SpectralMoments
 
     surface = SpectralMoments(M00, M20, M02, M40, M04, unit="um")
@@ -379,8 +379,8 @@ def test_population_elastic():
 
 
 def test_population_elasto_plastic():
-    from rough_contact import population
-    from rough_contact.asperity import AsperityMaterial
+    from rough_contact.micro import population
+    from rough_contact.micro.asperity import AsperityMaterial
     from rough_contact.surface import SpectralMoments
 
     surface = SpectralMoments(M00, M20, M02, M40, M04, unit="um")
@@ -528,7 +528,7 @@ def test_nearly_degenerate_elasto_plastic_build_ends_with_a_clear_error():
     minutes. Here a coarse population quadrature (n_quad = 12, ~8x cheaper) and the knot budget
     keep the test at ~3 CPU s; with the defaults the build ends by itself, model-limited, after
     47 knots (16 CPU s, 28 s wall on the loaded 2-core machine; issue 12's report)."""
-    from rough_contact.asperity import AsperityMaterial
+    from rough_contact.micro.asperity import AsperityMaterial
     from rough_contact.surface import SpectralMoments
 
     surface = SpectralMoments(0.2 * M00, M20, M02, M40, M04, unit="um")

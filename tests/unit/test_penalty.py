@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rough_contact.interface.contract import ConvergenceError
+from rough_contact.interface.contract import ConvergenceError, MultiplierLaw, NewtonTangentLaw
+from rough_contact.interface.enforcement import AugmentedLagrangian
 from rough_contact.interface.penalty import LinearPenalty, SoftplusPenalty
 from rough_contact.interface.state import InterfaceState
 
@@ -161,25 +162,27 @@ def test_softplus_newton_tangent_reversal():
         SoftplusPenalty(k_normal=1e4, width=1e-4, reversal_stiffness=-1.0)
 
 
-def _augmented_state(rng, n, scale=1.0):
-    """AugmentedState with random plastic slip and multipliers (pressure >= 0)."""
-    st = SoftplusPenalty(k_normal=1e4, width=1e-3, augmented=True).initial_state(n)
+def _multipliers(rng, n, scale=1.0):
+    """A state with random plastic slip and random multipliers (pressure >= 0)."""
+    st = SoftplusPenalty(k_normal=1e4, width=1e-3).initial_state(n)
     st.plastic_slip[:] = rng.uniform(-1, 1, (n, 2)) * 1e-6
-    st.multiplier[:, 0] = rng.uniform(0.5, 2, n) * scale
-    st.multiplier[:, 1:] = rng.uniform(-0.05, 0.05, (n, 2)) * scale
-    return st
+    lam = np.column_stack([rng.uniform(0.5, 2, n), rng.uniform(-0.05, 0.05, (n, 2))]) * scale
+    return st, lam
 
 
 @pytest.mark.parametrize("slip", [False, True])
-def test_augmented_tangent_fd_and_shifted_penalty(slip):
-    """Augmented law: the plain law with the gap shifted by lambda_N / k_N and the trial
-    traction by lambda_T (tau = lambda_T + k_T (s - s_p)); its tangent matches central
-    differences, and the trial state carries the tractions as the next multipliers."""
+def test_shifted_tangent_fd_and_shifted_penalty(slip):
+    """The law shifted by multipliers: the plain law with the gap shifted by lambda_N / k_N and
+    the trial traction by lambda_T (tau = lambda_T + k_T (s - s_p)); its tangent matches
+    central differences, and the update of the augmented Lagrangian takes its tractions as the
+    next multipliers."""
     rng = np.random.default_rng(11)
     n = 40
     kn, kt, mu, w = 1e4, 5e3, 0.3, 1e-3
-    law = SoftplusPenalty(k_normal=kn, width=w, k_tangential=kt, friction=mu, augmented=True)
-    committed = _augmented_state(rng, n)
+    plain = SoftplusPenalty(k_normal=kn, width=w, k_tangential=kt, friction=mu)
+    committed, lam = _multipliers(rng, n)
+    law = plain.with_multipliers(lam)
+    assert isinstance(plain, MultiplierLaw) and isinstance(law, NewtonTangentLaw)
     jump = np.column_stack([rng.uniform(-3e-4, 0.0, n),
                             rng.uniform(-1, 1, (n, 2)) * (1e-3 if slip else 1e-7)])
     res = law.evaluate(jump, committed)
@@ -188,83 +191,74 @@ def test_augmented_tangent_fd_and_shifted_penalty(slip):
     np.testing.assert_allclose(res.tangent, fd_tangent(law, jump, committed, h=1e-9),
                                rtol=1e-5, atol=1e-3)
     # the same numbers from the normal function and a hand-written radial return
-    p_expected, _ = law.normal(jump[:, 0] - committed.multiplier[:, 0] / kn)
+    p_expected, _ = plain.normal(jump[:, 0] - lam[:, 0] / kn)
     np.testing.assert_allclose(-res.traction[:, 0], p_expected, rtol=1e-13)
-    tau = committed.multiplier[:, 1:] + kt * (jump[:, 1:] - committed.plastic_slip)
+    tau = lam[:, 1:] + kt * (jump[:, 1:] - committed.plastic_slip)
     cap = mu * p_expected
     scale = np.minimum(1.0, cap / np.linalg.norm(tau, axis=1))
     np.testing.assert_allclose(res.traction[:, 1:], tau * scale[:, None], rtol=1e-12,
                                atol=1e-15)
-    np.testing.assert_array_equal(res.state.multiplier[:, 0], -res.traction[:, 0])
-    np.testing.assert_array_equal(res.state.multiplier[:, 1:], res.traction[:, 1:])
+    update = AugmentedLagrangian.update(lam, res)
+    np.testing.assert_array_equal(update.multipliers[:, 0], -res.traction[:, 0])
+    np.testing.assert_array_equal(update.multipliers[:, 1:], res.traction[:, 1:])
 
 
 def test_augmented_fixed_point_is_exact_coulomb():
     """Where the multipliers equal the tractions they produce, the constraints hold exactly:
     no elastic slip (s = s_p after the step) and, in contact, k_N g = 0 up to the softplus
     smoothing. Stick: the point has not moved since the committed state (s = s_p,n)."""
-    law = SoftplusPenalty(k_normal=1e4, width=1e-9, k_tangential=5e3, friction=0.5,
-                          augmented=True)
-    st = law.initial_state(2)
+    plain = SoftplusPenalty(k_normal=1e4, width=1e-9, k_tangential=5e3, friction=0.5)
+    st = plain.initial_state(2)
     st.plastic_slip[:] = [[1e-3, 0.0], [2e-3, -1e-3]]
     # point 0 sticks with a traction inside the cone, point 1 slips along +x by 1e-4 mm
-    st.multiplier[:] = [[2.0, 0.3, -0.4], [2.0, 1.0, 0.0]]
+    lam = np.array([[2.0, 0.3, -0.4], [2.0, 1.0, 0.0]])
     jump = np.array([[0.0, 1e-3, 0.0], [0.0, 2e-3 + 1e-4, -1e-3]])
-    res = law.evaluate(jump, st)
+    res = plain.with_multipliers(lam).evaluate(jump, st)
     assert res.slipping.tolist() == [False, True]
     np.testing.assert_allclose(res.traction, [[-2.0, 0.3, -0.4], [-2.0, 1.0, 0.0]], rtol=1e-12)
-    new, change = law.augment(st, res)
-    np.testing.assert_allclose(change, 0.0, atol=1e-12)          # a fixed point
+    update = AugmentedLagrangian.update(lam, res)
+    np.testing.assert_allclose(update.change, 0.0, atol=1e-12)          # a fixed point
     np.testing.assert_allclose(res.state.plastic_slip, jump[:, 1:], rtol=0, atol=1e-15)
     np.testing.assert_allclose(res.dissipation, [0.0, 1.0 * 1e-4], rtol=1e-10)
-    # augment keeps the committed history and takes the trial tractions as multipliers
+    # the update takes the trial tractions as multipliers
     moved = jump + np.array([[-1e-5, 2e-6, 0.0], [0.0, 0.0, 0.0]])
-    res2 = law.evaluate(moved, st)
-    new, change = law.augment(st, res2)
-    np.testing.assert_array_equal(new.plastic_slip, st.plastic_slip)
-    np.testing.assert_array_equal(new.multiplier[:, 0], -res2.traction[:, 0])
-    np.testing.assert_array_equal(new.multiplier[:, 1:], res2.traction[:, 1:])
-    np.testing.assert_allclose(change, np.linalg.norm(new.multiplier - st.multiplier, axis=1))
-    assert change[0] == pytest.approx(np.hypot(1e4 * 1e-5, 5e3 * 2e-6), rel=1e-6)
-    assert new is not st and st.multiplier[0, 0] == 2.0           # pure
+    res2 = plain.with_multipliers(lam).evaluate(moved, st)
+    update = AugmentedLagrangian.update(lam, res2)
+    np.testing.assert_array_equal(update.multipliers[:, 0], -res2.traction[:, 0])
+    np.testing.assert_array_equal(update.multipliers[:, 1:], res2.traction[:, 1:])
+    np.testing.assert_allclose(update.change,
+                               np.linalg.norm(update.multipliers - lam, axis=1))
+    assert update.change[0] == pytest.approx(np.hypot(1e4 * 1e-5, 5e3 * 2e-6), rel=1e-6)
+    assert lam[0, 0] == 2.0           # pure
 
 
 def test_augmented_control_and_bad_input():
     plain = SoftplusPenalty(k_normal=1e4, width=1e-4)
-    assert plain.augmentation() is None
     assert type(plain.initial_state(3)) is InterfaceState
-    law = SoftplusPenalty(k_normal=1e4, width=1e-4, augmented=True,
-                          augmentation_tolerance=1e-4, max_augmentations=7)
-    c = law.augmentation()
+    c = AugmentedLagrangian(tolerance=1e-4, max_updates=7)
     assert (c.tolerance, c.max_updates) == (1e-4, 7)
-    for kwargs, match in (({"augmentation_tolerance": 0.0}, "augmentation_tolerance"),
-                          ({"augmentation_tolerance": 1.0}, "augmentation_tolerance"),
-                          ({"max_augmentations": 0}, "max_augmentations = 0 is invalid"),
-                          ({"max_augmentations": 2.5}, "max_augmentations = 2.5 is invalid"),
-                          ({"augmented": 1}, "augmented = 1 is invalid")):
+    for kwargs, match in (({"tolerance": 0.0}, "augmentation tolerance"),
+                          ({"tolerance": 1.0}, "augmentation tolerance"),
+                          ({"max_updates": 0}, "max_updates = 0 is invalid"),
+                          ({"max_updates": 2.5}, "max_updates = 2.5 is invalid"),
+                          ({"max_updates": True}, "max_updates = True is invalid")):
         with pytest.raises(ValueError, match=match):
-            SoftplusPenalty(k_normal=1e4, width=1e-4, **kwargs)
-    # an augmented law needs its own state; a plain law cannot augment
-    with pytest.raises(ValueError, match="AugmentedState"):
-        law.evaluate(np.zeros((2, 3)), InterfaceState.zeros(2))
-    with pytest.raises(ValueError, match="augmented=True"):
-        plain.augment(plain.initial_state(1), plain.evaluate(np.zeros((1, 3)),
-                                                             plain.initial_state(1)))
+            AugmentedLagrangian(**kwargs)
+    # the multipliers must match the points; a law that cannot be shifted is refused
+    with pytest.raises(ValueError, match="multipliers of shape"):
+        plain.with_multipliers(np.zeros((3, 3))).evaluate(np.zeros((2, 3)),
+                                                          InterfaceState.zeros(2))
+    with pytest.raises(TypeError, match="MultiplierLaw"):
+        AugmentedLagrangian().check_law(LinearPenalty(1e3))
 
 
 def test_augmented_extrapolate():
     """The secant predictor of the multipliers: lambda + r (lambda - lambda_previous), the
-    pressure kept >= 0, the rest of the history untouched; pure."""
-    law = SoftplusPenalty(k_normal=1e4, width=1e-4, k_tangential=1e4, friction=0.3,
-                          augmented=True)
-    prev, now = law.initial_state(2), law.initial_state(2)
-    prev.multiplier[:] = [[1.0, 0.1, 0.0], [0.5, 0.0, 0.0]]
-    now.multiplier[:] = [[2.0, 0.3, -0.1], [0.2, 0.0, 0.0]]
-    now.plastic_slip[:] = [[1e-3, 0.0], [0.0, 2e-3]]
-    new = law.extrapolate(now, prev, 0.5)
-    np.testing.assert_allclose(new.multiplier, [[2.5, 0.4, -0.15], [0.05, 0.0, 0.0]])
-    np.testing.assert_allclose(law.extrapolate(now, prev, 1.0).multiplier[1], [0.0, 0.0, 0.0])
-    np.testing.assert_array_equal(new.plastic_slip, now.plastic_slip)
-    assert now.multiplier[0, 0] == 2.0
-    with pytest.raises(ValueError, match="extrapolate needs"):
-        law.extrapolate(now, law.initial_state(3), 0.5)
+    pressure kept >= 0; pure."""
+    prev = np.array([[1.0, 0.1, 0.0], [0.5, 0.0, 0.0]])
+    now = np.array([[2.0, 0.3, -0.1], [0.2, 0.0, 0.0]])
+    new = AugmentedLagrangian.extrapolate(now, prev, 0.5)
+    np.testing.assert_allclose(new, [[2.5, 0.4, -0.15], [0.05, 0.0, 0.0]])
+    np.testing.assert_allclose(AugmentedLagrangian.extrapolate(now, prev, 1.0)[1],
+                               [0.0, 0.0, 0.0])
+    assert now[0, 0] == 2.0

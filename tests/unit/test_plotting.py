@@ -1,4 +1,4 @@
-"""rough_contact.plotting: what the figures hold (the data of their lines, collections, colour
+"""rough_contact.io.plotting: what the figures hold (the data of their lines, collections, colour
 scales and labels, read back from the matplotlib objects), PNGs written, loop energies against
 an analytic loop."""
 
@@ -10,7 +10,7 @@ import sys
 import numpy as np
 import pytest
 
-from rough_contact import plotting
+from rough_contact.io import plotting
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 
@@ -26,7 +26,7 @@ def assert_png(path):
 
 
 def test_import_needs_neither_matplotlib_nor_fe_stack():
-    code = ("import sys, rough_contact.plotting\n"
+    code = ("import sys, rough_contact.io.plotting\n"
             "bad = {'matplotlib', 'dolfinx', 'ufl', 'petsc4py', 'basix', 'mpi4py', 'gmsh'}"
             " & set(sys.modules)\n"
             "assert not bad, bad\n")

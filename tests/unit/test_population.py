@@ -6,8 +6,8 @@ import math
 import numpy as np
 import pytest
 
-from rough_contact import population as pop
-from rough_contact.asperity import AsperityMaterial
+from rough_contact.micro import population as pop
+from rough_contact.micro.asperity import AsperityMaterial
 from rough_contact.surface import SpectralMoments
 
 E_STAR = 1.14e5  # N/mm^2, Tables 1-2

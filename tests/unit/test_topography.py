@@ -1,4 +1,4 @@
-"""Measured surfaces in (rough_contact.topography) and the moments in arbitrary axes (surface.py).
+"""Measured surfaces in (rough_contact.surface.topography) and the moments in arbitrary axes (surface.py).
 
 References we did not write: closed-form moments of Gaussian spectra checked against direct
 quadrature of the spectrum, finite-difference slopes of the map in real space, invariants of
@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from rough_contact.surface import MomentTensor, SpectralMoments
-from rough_contact.topography import (AnisotropicGaussianPSD, HeightMap, analyze, detrend,
+from rough_contact.surface.topography import (AnisotropicGaussianPSD, HeightMap, analyze, detrend,
                                       read_height_map, read_instrument, read_npy, read_text_grid,
                                       read_xyz, synthetic_height_map, write_height_map, write_npy)
 
@@ -320,7 +320,7 @@ def test_bad_inputs_give_clear_errors(tmp_path, table1_map):
 
 
 def test_topography_is_a_pure_layer():
-    code = ("import sys, rough_contact.topography\n"
+    code = ("import sys, rough_contact.surface.topography\n"
             "bad = {'dolfinx', 'ufl', 'petsc4py', 'basix', 'mpi4py', 'gmsh', 'SurfaceTopography'}"
             " & set(sys.modules)\n"
             "assert not bad, bad\n")

@@ -1,6 +1,6 @@
 """Normal (and tangential) interface law of a rough surface computed by boundary elements.
 
-The statistical laws (:mod:`rough_contact.population`) sum independent asperities; this module
+The statistical laws (:mod:`rough_contact.micro.population`) sum independent asperities; this module
 solves the *exact* frictionless contact of the measured or synthetic height map against a rigid
 flat on a periodic elastic half-space (FFT boundary elements) at a sequence of mean pressures, and
 tabulates the result as a :class:`~rough_contact.interface.normal.NormalLaw` (built by
@@ -61,14 +61,17 @@ import time
 import warnings
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Dict, Optional, Protocol, Sequence, Tuple
+from typing import TYPE_CHECKING, Dict, Optional, Protocol, Sequence, Tuple
 
 import numpy as np
 from scipy.fft import irfft2 as _irfft2, rfft2 as _rfft2
 
-from rough_contact.interface.normal import NormalLaw
-from rough_contact.surface import SpectralMoments
-from rough_contact.validation import check_scalar
+from ..surface import SpectralMoments
+from ..validation import check_scalar
+from .tables import hermite_eval
+
+if TYPE_CHECKING:          # annotations only: the law class lives in the layer above
+    from ..interface.normal import NormalLaw
 
 __all__ = [
     "BEMCurves", "BEMLaw", "BackendUnavailableError", "HeightMapWarning",
@@ -847,17 +850,22 @@ def _realisation_table(c: BEMCurves, r: int):
 
 def _hermite_eval(h, p, k, a, x):
     """p, k, a of one realisation at separations x (inside its range), consistent with its k."""
-    from scipy.interpolate import CubicHermiteSpline, PchipInterpolator
+    from scipy.interpolate import PchipInterpolator
 
-    q = CubicHermiteSpline(h, np.log(p), -k / p)
-    pv = np.exp(q(x))
-    kv = -pv * q.derivative()(x)
+    q, dq = hermite_eval(h, np.log(p), -k / p, x)
+    pv = np.exp(q)
+    kv = -pv * dq
     av = np.exp(PchipInterpolator(h, np.log(a))(x))
     return pv, kv, av
 
 
 def _law_from_data(h, p, k, a, use_k: bool):
     """NormalLaw from table data; Hermite with k when consistent, else PCHIP. -> (law, source)."""
+    # The BEM result is handed over as the interface layer's NormalLaw (BEMLaw.normal), the one
+    # reference of micro/ to the layer above: imported here, so that importing rough_contact.micro
+    # never loads rough_contact.interface. The table itself is built by tables.tabulate_data.
+    from ..interface.normal import NormalLaw
+
     if use_k:
         try:
             return NormalLaw.from_table(h, p, a, k=k), "BEM stiffness (Hermite)"
@@ -1023,7 +1031,7 @@ def bem_law_from_moments(moments: SpectralMoments, *, E_star: float, nu: float =
                          cache_dir: Optional[os.PathLike] = None) -> BEMLaw:
     """The BEM law of a surface known only by its spectral moments, with realisation scatter.
 
-    Gaussian realisations of the spectrum fitted by :func:`rough_contact.spectrum.fit_spectrum`
+    Gaussian realisations of the spectrum fitted by :func:`rough_contact.surface.spectrum.fit_spectrum`
     (the assumed shape is documented there: stretched isotropic self-affine with roll-off) are
     solved at the same pressures and averaged at equal separation (:func:`law_from_curves`).
 
@@ -1036,13 +1044,13 @@ def bem_law_from_moments(moments: SpectralMoments, *, E_star: float, nu: float =
         pixels_per_wavelength: pixels per shortest wavelength of the spectrum (grid study in
             docs/bem.md).
         periods: longest wavelengths per side of every realisation.
-        shape: :class:`rough_contact.spectrum.SpectrumShape` (default H = 0.8, plateau 2).
+        shape: :class:`rough_contact.surface.spectrum.SpectrumShape` (default H = 0.8, plateau 2).
         pressures: mean pressures [MPa]; default from the moments' rms slope over area_range.
 
     Returns:
         :class:`BEMLaw` whose ``*_std`` give the scatter between realisations.
     """
-    from rough_contact.spectrum import SpectrumShape, fit_spectrum
+    from rough_contact.surface.spectrum import SpectrumShape, fit_spectrum
 
     nr = int(check_scalar("n_realisations", n_realisations, lo=1.0, lo_open=False, hi=1e4))
     backend = _default_backend(backend, hardness)

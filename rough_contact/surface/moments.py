@@ -30,7 +30,7 @@ from typing import Tuple
 
 import numpy as np
 
-from .validation import check_scalar
+from ..validation import check_scalar
 
 __all__ = ["SpectralMoments", "moments_from_height_map", "psum", "plasticity_index", "MomentTensor",
            "moment_tensor_from_height_map", "MOMENT_ORDERS", "WINDOWS"]
@@ -261,17 +261,13 @@ def moments_from_height_map(z, dx: float, dy: float | None = None, method: str =
     Raises:
         ValueError: for a non-2D or non-finite map, non-positive steps or unknown method.
     """
-    z, dx, dy = _checked_map(z, dx, dy)
-    z = z - z.mean()
-    nx, ny = z.shape
     if method == "fft":
-        P, kx, ky = _power_spectrum(z, dx, dy)
-        m00 = P.sum()
-        m20 = (P * kx**2).sum()
-        m02 = (P * ky**2).sum()
-        m40 = (P * kx**4).sum()
-        m04 = (P * ky**4).sum()
+        # the one FFT moment computation of the package (no window: the map is periodic)
+        m = _fft_moments(z, dx, dy, window="none")
+        m00, m20, m02, m40, m04 = (m[(0, 0)], m[(2, 0)], m[(0, 2)], m[(4, 0)], m[(0, 4)])
     elif method == "fd":
+        z, dx, dy = _checked_map(z, dx, dy)
+        z = z - z.mean()
         zx = (np.roll(z, -1, 0) - np.roll(z, 1, 0)) / (2 * dx)
         zy = (np.roll(z, -1, 1) - np.roll(z, 1, 1)) / (2 * dy)
         zxx = (np.roll(z, -1, 0) - 2 * z + np.roll(z, 1, 0)) / dx**2
@@ -423,6 +419,37 @@ def _window_1d(n: int, window: str) -> np.ndarray:
     raise ValueError(f"window = {window!r} is invalid: valid windows are {list(WINDOWS)}")
 
 
+def _fft_moments(z, dx: float, dy: float | None, window: str) -> dict:
+    """Moments {(p, q): m_pq} of orders 0, 2, 4 of a height map in its own unit (FFT).
+
+    The one spectral computation behind :func:`moment_tensor_from_height_map` and
+    :func:`moments_from_height_map` (method "fft"); conventions and the window correction as
+    described there. z: (nx, ny), axis 0 along x [unit]; dx, dy [unit].
+    """
+    z, dx, dy = _checked_map(z, dx, dy)
+    nx, ny = z.shape
+    w = np.outer(_window_1d(nx, window), _window_1d(ny, window))
+    P, kx, ky = _power_spectrum(w * (z - z.mean()), dx, dy)
+    Pw, _, _ = _power_spectrum(w, dx, dy)
+    norm = Pw.sum()                      # <w^2> (Parseval)
+    kxp = [np.ones_like(kx), kx, kx**2, kx**3, kx**4]
+    kyp = [np.ones_like(ky), ky, ky**2, ky**3, ky**4]
+    raw = {(p, q): float((P * kxp[p] * kyp[q]).sum()) / norm for p, q in MOMENT_ORDERS}
+    m = {}
+    if window == "none":
+        m = raw
+    else:
+        wmom = {(r, s_): float((Pw * kxp[r] * kyp[s_]).sum()) / norm
+                for r in range(5) for s_ in range(5) if r + s_ <= 4}
+        for p, q in MOMENT_ORDERS:      # increasing order: lower moments are known
+            acc = raw[(p, q)]
+            for a, b in MOMENT_ORDERS:
+                if a <= p and b <= q and (a, b) != (p, q):
+                    acc -= math.comb(p, a) * math.comb(q, b) * m[(a, b)] * wmom[(p - a, q - b)]
+            m[(p, q)] = acc / wmom[(0, 0)]
+    return m
+
+
 def moment_tensor_from_height_map(z, dx: float, dy: float | None = None, unit: str = "um",
                                   window: str = "none") -> MomentTensor:
     """All moments of orders 0, 2, 4 (incl. m11, m31, m22, m13) of a sampled height map (FFT).
@@ -453,25 +480,5 @@ def moment_tensor_from_height_map(z, dx: float, dy: float | None = None, unit: s
     Returns:
         MomentTensor in the map axes (stored in mm).
     """
-    z, dx, dy = _checked_map(z, dx, dy)
-    nx, ny = z.shape
-    w = np.outer(_window_1d(nx, window), _window_1d(ny, window))
-    P, kx, ky = _power_spectrum(w * (z - z.mean()), dx, dy)
-    Pw, _, _ = _power_spectrum(w, dx, dy)
-    norm = Pw.sum()                      # <w^2> (Parseval)
-    kxp = [np.ones_like(kx), kx, kx**2, kx**3, kx**4]
-    kyp = [np.ones_like(ky), ky, ky**2, ky**3, ky**4]
-    raw = {(p, q): float((P * kxp[p] * kyp[q]).sum()) / norm for p, q in MOMENT_ORDERS}
-    m = {}
-    if window == "none":
-        m = raw
-    else:
-        wmom = {(r, s_): float((Pw * kxp[r] * kyp[s_]).sum()) / norm
-                for r in range(5) for s_ in range(5) if r + s_ <= 4}
-        for p, q in MOMENT_ORDERS:      # increasing order: lower moments are known
-            acc = raw[(p, q)]
-            for a, b in MOMENT_ORDERS:
-                if a <= p and b <= q and (a, b) != (p, q):
-                    acc -= math.comb(p, a) * math.comb(q, b) * m[(a, b)] * wmom[(p - a, q - b)]
-            m[(p, q)] = acc / wmom[(0, 0)]
+    m = _fft_moments(z, dx, dy, window)
     return MomentTensor(*(m[o] for o in MOMENT_ORDERS), unit=unit)

@@ -1,7 +1,7 @@
 """Gaussian rough surfaces with a prescribed spectrum, fitted to five spectral moments.
 
 A user who has only the spectral moments m00, m20, m02, m40, m04 of a surface (the statistical
-law's input) gets height maps for the boundary-element law (:mod:`rough_contact.bem`) from here.
+law's input) gets height maps for the boundary-element law (:mod:`rough_contact.micro.bem`) from here.
 Five moments do not determine a spectrum; this module **assumes** the following shape and says
 so wherever it is used.
 
@@ -45,8 +45,8 @@ from typing import Tuple
 import numpy as np
 from scipy.optimize import brentq
 
-from rough_contact.surface import SpectralMoments
-from rough_contact.validation import check_scalar
+from .moments import SpectralMoments
+from ..validation import check_scalar
 
 __all__ = ["SpectrumShape", "StretchedSpectrum", "fit_spectrum", "example_surfaces"]
 

@@ -37,14 +37,12 @@ first contact surface:
 
 Everything is gathered to rank 0 and written there (the interface is surface-sized). The
 facets and vertices are ordered by coordinates, so the files do not depend on the number of
-ranks. Crash safety as in :mod:`rough_contact.solver.output`: the HDF5 file is reopened and
+ranks. Crash safety as in :mod:`rough_contact.io.results`: the HDF5 file is reopened and
 closed at every step (flushed), and the XML index, which is the only thing that lists a step,
 is rewritten atomically (temporary file + ``os.replace``) after the step's data are closed:
 a failure never corrupts earlier steps.
 
-:func:`prepare_output_dir` makes a folder hold exactly one run: it refuses a folder with
-results of an earlier run unless ``overwrite=True``, and then removes those files (only the
-files this project's writers produce).
+The output folder holds exactly one run (:func:`rough_contact.io.files.prepare_output_dir`).
 """
 
 from __future__ import annotations
@@ -59,15 +57,17 @@ from typing import Any, Optional, Protocol, Sequence
 import numpy as np
 from mpi4py import MPI
 
-from ..solver.output import atomic_write_text
-from .contact import PointFields
+from rough_contact.fem import compat
+from rough_contact.fem.collective import run_on_root
+from rough_contact.fem.contact import PointFields
+from rough_contact.io.files import OutputExistsError, atomic_write_text, run_files
 
 __all__ = [
     "STATUS_OPEN", "STATUS_STICK", "STATUS_SLIP", "STATUS_NAMES", "InterfaceOutputSource",
     "PointOutput", "FacetOutput", "SurfaceMesh", "InterfaceWriter", "InterfaceResults",
-    "OutputExistsError", "RUN_OUTPUT_PATTERNS", "FACET_FIELD_NAMES", "POINT_FIELD_NAMES", "facet_average", "facet_status",
+    "FACET_FIELD_NAMES", "POINT_FIELD_NAMES", "facet_average", "facet_status",
     "point_output", "facet_output", "facet_vertex_coordinates", "gather_surface",
-    "prepare_output_dir", "pseudo_time", "read_interface_results",
+    "pseudo_time", "read_interface_results",
 ]
 
 STATUS_OPEN, STATUS_STICK, STATUS_SLIP = 0, 1, 2
@@ -75,18 +75,6 @@ STATUS_NAMES = ("open", "stick", "slip")
 _TIE = 1e-9  # relative area below which two parts of a facet count as equal
 
 FACET_XDMF, POINT_XDMF, H5_FILE = "interface.xdmf", "interface_points.xdmf", "interface.h5"
-
-# Files the project's writers produce in an output folder (ResultWriter: displacement, history,
-# the former point cloud with its per-step .bin files; InterfaceWriter: the surface files), and
-# the temporary files of their atomic writes (``<name>.tmp<pid>``).
-RUN_OUTPUT_PATTERNS = (
-    r"displacement\.xdmf", r"displacement\.h5", r"history\.csv", r"interface\.xdmf",
-    r"interface\.h5", r"interface_points\.xdmf", r"interface_\d{4,}\.bin",
-)
-
-
-class OutputExistsError(FileExistsError, ValueError):
-    """An output folder holds results of an earlier run and ``overwrite`` was not given."""
 
 
 class InterfaceOutputSource(Protocol):
@@ -310,8 +298,7 @@ def facet_vertex_coordinates(interface: InterfaceOutputSource) -> np.ndarray:
     cells = f_to_c.array[f_to_c.offsets[facets]]
     c_to_f = msh.topology.connectivity(tdim, tdim - 1).array.reshape(-1, ref_facets.shape[0])
     local_facet = np.argmax(c_to_f[cells] == facets[:, None], axis=1)
-    gdm = msh.geometry.dofmap
-    gdofs = gdm.array.reshape(len(gdm.offsets) - 1, -1)
+    gdofs = compat.geometry_dofmap(msh)
     # the first geometry nodes of a cell are its vertices, in the reference cell's order
     vx = msh.geometry.x[gdofs[cells[:, None], ref_facets[local_facet]]]
     if nv == 4:  # basix quadrilateral vertices are in tensor order; XDMF wants them cyclic
@@ -405,75 +392,6 @@ def pseudo_time(load_factors: Sequence[float]) -> np.ndarray:
 
 
 # --------------------------------------------------------------------------------------------
-# output folder
-# --------------------------------------------------------------------------------------------
-def _run_files(outdir: str, patterns: Sequence[str]) -> list:
-    if not os.path.isdir(outdir):
-        return []
-    regex = re.compile("|".join(f"(?:{p})(?:\\.tmp\\d+)?" for p in patterns))
-    return sorted(f for f in os.listdir(outdir)
-                  if regex.fullmatch(f) and os.path.isfile(os.path.join(outdir, f)))
-
-
-def _collective(comm: MPI.Comm, root_action, root: int = 0):
-    """Run ``root_action()`` on root; every rank returns its result or raises its error."""
-    result, error = None, None
-    if comm.rank == root:
-        try:
-            result = root_action()
-        except Exception as exc:  # noqa: BLE001 -- re-raised on every rank below
-            error = exc
-    result, error = comm.bcast((result, error), root=root)
-    if error is not None:
-        raise error
-    return result
-
-
-def prepare_output_dir(outdir: str, comm: MPI.Comm = MPI.COMM_WORLD, overwrite: bool = False,
-                       extra_patterns: Sequence[str] = ()) -> list:
-    """Make ``outdir`` ready for exactly one run (collective).
-
-    Creates the folder. If it holds files a writer of this project produces
-    (``RUN_OUTPUT_PATTERNS``: displacement.xdmf/.h5, history.csv, interface.xdmf/.h5,
-    interface_points.xdmf, interface_NNNN.bin, their temporaries) it raises
-    :class:`OutputExistsError`, or with ``overwrite=True`` removes exactly those files. Other
-    files are never touched.
-
-    Args:
-        outdir: output folder.
-        comm: communicator (rank 0 does the file system work).
-        overwrite: remove the results of an earlier run instead of refusing.
-        extra_patterns: further file-name regular expressions (full match) of the caller's own
-            outputs, e.g. ``r"slip_directions.*\\.png"``.
-
-    Returns:
-        Names of the removed files.
-
-    Raises:
-        OutputExistsError: earlier results present and ``overwrite`` is False.
-    """
-    outdir = os.fspath(outdir)
-    patterns = tuple(RUN_OUTPUT_PATTERNS) + tuple(extra_patterns)
-
-    def act():
-        if os.path.exists(outdir) and not os.path.isdir(outdir):
-            raise ValueError(f"output directory {outdir!r} exists and is not a directory")
-        os.makedirs(outdir, exist_ok=True)
-        found = _run_files(outdir, patterns)
-        if found and not overwrite:
-            shown = ", ".join(found[:6]) + (", ..." if len(found) > 6 else "")
-            raise OutputExistsError(
-                f"output directory {outdir!r} holds results of an earlier run ({len(found)} "
-                f"files: {shown}); pass overwrite=True (--overwrite) to replace them, or choose "
-                "another directory")
-        for f in found:
-            os.remove(os.path.join(outdir, f))
-        return found
-
-    return _collective(comm, act)
-
-
-# --------------------------------------------------------------------------------------------
 # the writer
 # --------------------------------------------------------------------------------------------
 def _data_item(h5name: str, path: str, shape: tuple, dtype: np.dtype) -> str:
@@ -493,7 +411,8 @@ class InterfaceWriter:
         points: also write ``interface_points.xdmf``, the exact values at the quadrature points.
         overwrite: replace this writer's files from an earlier run; without it, existing
             ``interface.xdmf``/``interface.h5``/``interface_points.xdmf`` raise
-            :class:`OutputExistsError` (see also :func:`prepare_output_dir`).
+            :class:`~rough_contact.io.files.OutputExistsError` (see also
+            :func:`~rough_contact.io.files.prepare_output_dir`).
 
     Collective: construct and call :meth:`write` on every rank.
     """
@@ -524,7 +443,7 @@ class InterfaceWriter:
             self._point_order = (surface.order[:, None] * n_qp + np.arange(n_qp)).ravel()[within]
             if resume:                # the resumed run's files: restore() trims them
                 return
-            mine = _run_files(self.outdir, (re.escape(FACET_XDMF), re.escape(H5_FILE),
+            mine = run_files(self.outdir, (re.escape(FACET_XDMF), re.escape(H5_FILE),
                                             re.escape(POINT_XDMF)))
             if mine and not overwrite:
                 raise OutputExistsError(
@@ -538,7 +457,7 @@ class InterfaceWriter:
         self._point_geometry = None if xq is None else xq["x"]   # rank 0 only
         self._point_order = None  # rank 0 only, like every gathered array
         self._specs: dict = {}
-        _collective(self.comm, create)
+        run_on_root(self.comm, create)
 
     def _new_h5(self) -> None:
         import h5py
@@ -593,7 +512,7 @@ class InterfaceWriter:
             self._write_xml()
             return self.times, self.load_factors
 
-        self.times, self.load_factors = _collective(self.comm, act)
+        self.times, self.load_factors = run_on_root(self.comm, act)
         self.times, self.load_factors = list(self.times), list(self.load_factors)
 
     # ------------------------------------------------------------------ XML
@@ -703,7 +622,7 @@ class InterfaceWriter:
                 self.load_factors.pop()
                 raise
 
-        _collective(self.comm, act)
+        run_on_root(self.comm, act)
         if self.comm.rank != 0:
             self.times.append(t)
             self.load_factors.append(lam)

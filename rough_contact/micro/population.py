@@ -51,8 +51,8 @@ from scipy import special
 
 from .asperity import (AsperityMaterial, eccentricity_from_lambda, shape_factors,
                        shape_factors_from_lambda)
-from .surface import SpectralMoments
-from .validation import check_scalar
+from ..surface import SpectralMoments
+from ..validation import check_scalar
 
 __all__ = ["PopulationResult", "elastic", "elasto_plastic", "greenwood_williamson",
            "bearing_area", "bearing_area_ratio", "F_n", "log_F_n"]

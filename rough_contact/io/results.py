@@ -8,13 +8,14 @@ that was written stays readable:
 * ``displacement.xdmf/.h5``: DOLFINx ``XDMFFile``, reopened in append mode and closed at every
   step (so the HDF5 file is flushed and the XML index rewritten per step).
 * ``interface.xdmf/.h5``: the contact surface as facets with the interface fields per increment
-  (``rough_contact.fem.interface_output.InterfaceWriter``; ``interface_points.xdmf`` holds the
+  (``rough_contact.io.interface_output.InterfaceWriter``; ``interface_points.xdmf`` holds the
   exact quadrature-point values), ParaView shows it by default (``docs/output.md``).
 * Time values are the load factor while the load rises from 0, then the load path's length
   (``pseudo_time``): ParaView's time axis follows the load, never the step number.
 * The folder holds exactly one run: earlier results make the writer refuse, or with
-  ``overwrite=True`` they are removed first (``prepare_output_dir``).
-* ``history.csv``: one row per converged increment, rewritten atomically.
+  ``overwrite=True`` they are removed first (``rough_contact.io.files.prepare_output_dir``).
+* ``history.csv``: one row per converged increment, rewritten atomically
+  (``rough_contact.io.files.atomic_write``).
 * Restart (``load_path(..., checkpoint=, outputs=[writer])``): the writer's state (CSV rows,
   load factors, the number of XDMF steps) is saved in every checkpoint
   (:meth:`ResultWriter.checkpoint_state`); a writer built with ``resume=True`` leaves the folder
@@ -32,44 +33,19 @@ import io
 import os
 import warnings
 import xml.etree.ElementTree as ET
-from typing import Iterable, Optional, Sequence, Union
+from typing import Optional, Sequence
 
 import numpy as np
 from mpi4py import MPI
 
-__all__ = ["ResultWriter", "CsvRecorder", "gather_points", "atomic_write", "atomic_write_text",
-           "truncate_time_series"]
+from dolfinx import fem
+from dolfinx.io import XDMFFile
+from rough_contact.fem import compat
+from rough_contact.fem.collective import run_on_root
+from rough_contact.io.files import atomic_write, atomic_write_text, prepare_output_dir
+from rough_contact.io.interface_output import InterfaceWriter, pseudo_time
 
-
-def atomic_write(path: str, content: Union[str, bytes, Iterable[bytes]]) -> None:
-    """Write ``content`` to ``path`` atomically: a temporary file, fsync, ``os.replace``.
-
-    A crash leaves either the old file or the new one, never a truncated one. Every file this
-    module writes goes through here.
-
-    Args:
-        path: destination.
-        content: text (written as UTF-8, newlines unchanged), bytes, or an iterable of bytes
-            chunks (written one after the other).
-    """
-    if isinstance(content, str):
-        chunks: Iterable[bytes] = [content.encode("utf-8")]
-    elif isinstance(content, (bytes, bytearray)):
-        chunks = [bytes(content)]
-    else:
-        chunks = content
-    tmp = f"{path}.tmp{os.getpid()}"
-    with open(tmp, "wb") as fh:
-        for chunk in chunks:
-            fh.write(chunk)
-        fh.flush()
-        os.fsync(fh.fileno())
-    os.replace(tmp, path)
-
-
-def atomic_write_text(path: str, text: str) -> None:
-    """Write ``text`` to ``path`` atomically (:func:`atomic_write`)."""
-    atomic_write(path, text)
+__all__ = ["ResultWriter", "CsvRecorder", "gather_points", "truncate_time_series"]
 
 
 def gather_points(comm: MPI.Comm, points: np.ndarray, fields: dict, root: int = 0):
@@ -183,8 +159,6 @@ class ResultWriter:
     def __init__(self, outdir: str, comm: MPI.Comm, u=None, interface=None, *,
                  points: bool = True, extra_columns: tuple = (), overwrite: bool = False,
                  extra_patterns: Sequence[str] = (), resume: bool = False):
-        from rough_contact.fem.interface_output import InterfaceWriter, prepare_output_dir
-
         self.outdir = os.fspath(outdir)
         self.comm = comm
         if resume:       # the files belong to the run being resumed: restore() trims them
@@ -206,23 +180,18 @@ class ResultWriter:
         self._xdmf_started = False
         self._xdmf_steps = 0
         if u is not None:
-            from dolfinx import fem
-
             msh = u.function_space.mesh
-            degree = msh.geometry.cmap.degree
+            degree = compat.geometry_degree(msh)
             V = u.function_space
-            if V.ufl_element().degree() == degree:
+            if compat.element_degree(V) == degree:
                 self._u_out = u
             else:  # XDMF needs the geometry's degree
-                self._u_out = fem.Function(
-                    fem.VectorFunctionSpace(msh, ("Lagrange", degree)), name=u.name)
+                self._u_out = fem.Function(compat.vector_space(msh, degree), name=u.name)
         self.csv_path = os.path.join(self.outdir, "history.csv")
         self.u_path = os.path.join(self.outdir, "displacement.xdmf")
 
     # ------------------------------------------------------------------ displacement
     def _write_displacement(self, t: float) -> None:
-        from dolfinx.io import XDMFFile
-
         if self._u_out is not self.u:
             self._u_out.interpolate(self.u)
         mode = "a" if self._xdmf_started else "w"
@@ -244,15 +213,13 @@ class ResultWriter:
     def restore(self, state: dict) -> None:
         """Continue from :meth:`checkpoint_state` (collective): cut the CSV, the displacement
         series and the interface files back to the checkpointed step."""
-        from rough_contact.fem.interface_output import _collective
-
         self.rows = list(state["rows"])
         self.load_factors = list(state["load_factors"])
         if self.comm.rank == 0 and self.rows:
             self._flush_csv()
         if self.u is not None:
             n = int(state["xdmf_steps"])
-            ok = _collective(self.comm, lambda: truncate_time_series(self.u_path, n)) if n else \
+            ok = run_on_root(self.comm, lambda: truncate_time_series(self.u_path, n)) if n else \
                 False
             self._xdmf_started = ok
             self._xdmf_steps = n if ok else 0
@@ -286,8 +253,6 @@ class ResultWriter:
 
         Collective.
         """
-        from rough_contact.fem.interface_output import pseudo_time
-
         self.load_factors.append(float(inc.load_factor))
         t = float(pseudo_time(self.load_factors)[-1])
         if self.u is not None:

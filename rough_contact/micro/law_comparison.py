@@ -1,50 +1,25 @@
 """Statistical vs boundary-element normal law of one rough surface: laws, tables, ratios, plots.
 
-The command-line tool is ``demos/compare_laws.py``; the description follows.
-"""
-# # Statistical vs boundary-element normal law of one rough surface
-#
-# For one surface this tool builds, side by side,
-#
-# * the statistical laws of this package (asperity sums, :mod:`rough_contact.population`):
-#   the strongly anisotropic elastic model (52)-(55), its elasto-plastic version (78)-(88) and
-#   McCool's equivalent Greenwood-Williamson model, all from the five spectral moments;
-# * the boundary-element laws (:mod:`rough_contact.bem`): exact elastic contact of the surface
-#   itself, and its saturated variant (pressure capped at the flow pressure c_h H of the
-#   statistical model's fully plastic asperities, eq 66),
-#
-# and prints and plots p, A/A0 and k = -dp/dh against h/sigma and against the load, the ratios
-# statistical/BEM at equal separation and at equal load, and the load range over which each
-# statistical law agrees with the BEM law within a tolerance.
-#
-# The surface is either one of the example surfaces (``--surface``; spectral moments only, so
-# the BEM law averages Gaussian realisations of the assumed spectrum, docs/bem.md), spectral
-# moments (``--moments m00 m20 m02 m40 m04`` in the paper's um convention), or a measured height
-# map (``--height-map file.npy --dx STEP --unit um``: the statistical laws use its moments, the
-# BEM law the map itself, ``--boundary mirror`` for a non-periodic measurement).
-#
-# Units: mm, N, MPa inside; separations printed as h/sigma, sigma = sqrt(m00).
-#
-# Run: ``bash run.sh python demos/compare_laws.py --surface anisotropic [--tol 0.1]
-# [--realisations 8] [--ppw 8] [--psi 0.35] [--out results/compare]``.
+Library functions: :func:`statistical_laws`, :func:`bem_laws`, the tables and ratios,
+:func:`compare` (all of it for one source), and the sources :func:`source_from_example`,
+:func:`source_from_moments`, :func:`source_from_height_map`. The command line, and the
+description of what is compared, is ``demos/compare_laws.py``.
 
+Units: mm, N, MPa inside; separations printed as h/sigma, sigma = sqrt(m00).
+"""
 from __future__ import annotations
 
-import argparse
 import csv
 import math
 import os
-import sys
 import time
 import warnings
 
 import numpy as np
 
-from rough_contact import bem
-from rough_contact.asperity import AsperityMaterial
-from rough_contact.interface.normal import NormalLaw
-from rough_contact.spectrum import SpectrumShape, example_surfaces
-from rough_contact.surface import SpectralMoments, moments_from_height_map
+from . import bem
+from .asperity import AsperityMaterial
+from ..surface import SpectralMoments, SpectrumShape, example_surfaces, moments_from_height_map
 
 E_STAR = 1.067e5     # MPa, two steel bodies E = 200 GPa, nu = 0.25 (the paper's punch)
 NU = 0.25
@@ -58,6 +33,10 @@ AGREE = ("k_at_p", "a_at_p", "p_at_h")
 def statistical_laws(moments: SpectralMoments, E_star: float, material: AsperityMaterial,
                      plastic: bool = True):
     """The package's statistical laws of the surface: dict name -> NormalLaw."""
+    # the laws are the interface layer's NormalLaw (the layer above micro/): imported here so
+    # that importing rough_contact.micro never loads rough_contact.interface
+    from rough_contact.interface.normal import NormalLaw
+
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)   # isotropic surfaces: reported in the text
         out = {STAT[0]: NormalLaw.elastic(moments, E_star),
@@ -120,7 +99,7 @@ def table_vs_load(laws: dict, sigma: float, pressures):
 
 
 def ratio_rows(stat: dict, reference: "bem.BEMLaw", pressures, sigma):
-    """Ratios statistical/BEM over the load range (rough_contact.bem.law_ratios).
+    """Ratios statistical/BEM over the load range (rough_contact.micro.bem.law_ratios).
 
     ``se p/A/k``: relative standard errors of the BEM mean (realisation std / sqrt(n)) at the
     BEM separation of each load - the uncertainty of every ratio from the finite sample.
@@ -318,78 +297,51 @@ def compare(source: dict, *, E_star=E_STAR, nu=NU, psi=0.35, tol=0.1, realisatio
                 sigma=sigma, time_stat=t_stat, time_bem=t_bem, material=material, cap=cap)
 
 
-def source_from_args(args):
-    """The surface: example, moments or height map -> dict(kind, moments, ...)."""
-    if args.height_map:
-        scale = {"um": 1e-3, "mm": 1.0, "m": 1e3}[args.unit]
-        data = np.load(args.height_map)
-        z = data["z"] if isinstance(data, np.lib.npyio.NpzFile) else data
-        dx = args.dx
-        dy = args.dy if args.dy is not None else dx
-        if dx is None:
-            raise SystemExit("--height-map needs --dx (sampling step, in --unit)")
-        z_mm = np.asarray(z, float) * scale
-        # moments of the map as the BEM sees it (mirrored if not periodic), by central
-        # differences: an FFT of a non-periodic map counts the edge jump as roughness
-        zp, _ = bem.check_height_map(z_mm, dx * scale, dy * scale, boundary=args.boundary)
-        moments = moments_from_height_map(zp, dx * scale, dy * scale, method="fd", unit="mm")
-        return dict(kind="map", z=z_mm, dx=dx * scale, dy=dy * scale, boundary=args.boundary,
-                    moments=moments), os.path.basename(args.height_map)
-    if args.moments:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", UserWarning)
-            m = SpectralMoments(*args.moments, unit="um")
-        return dict(kind="moments", moments=m, shape=SpectrumShape(args.hurst, args.plateau)), \
-            "moments " + " ".join(f"{v:g}" for v in args.moments)
-    m, shape = example_surfaces()[args.surface]
-    return dict(kind="moments", moments=m, shape=shape), args.surface
+def source_from_height_map(z, dx: float, dy: float | None = None, *, unit: str = "um",
+                           boundary: str = "mirror"):
+    """The surface as a measured height map -> dict(kind="map", z, dx, dy, boundary, moments).
+
+    Args:
+        z: (nx, ny) heights, axis 0 along x (the grain) [unit].
+        dx, dy: sampling steps along axes 0 and 1 [unit] (dy defaults to dx).
+        unit: length unit of z, dx, dy: "um", "mm" or "m".
+        boundary: "periodic", "mirror" or "window" (see :func:`bem.check_height_map`).
+    Returns:
+        the source for :func:`compare` (lengths in mm); the statistical laws use the map's
+        moments (central differences), the BEM law the map itself.
+    """
+    scales = {"um": 1e-3, "mm": 1.0, "m": 1e3}
+    if unit not in scales:
+        raise ValueError(f"unit = {unit!r} is invalid: valid units are {sorted(scales)}")
+    scale = scales[unit]
+    if dx is None:
+        raise ValueError("dx = None is invalid: the height map needs its sampling step dx > 0 "
+                         f"[{unit}]")
+    dy = dx if dy is None else dy
+    z_mm = np.asarray(z, float) * scale
+    # moments of the map as the BEM sees it (mirrored if not periodic), by central
+    # differences: an FFT of a non-periodic map counts the edge jump as roughness
+    zp, _ = bem.check_height_map(z_mm, dx * scale, dy * scale, boundary=boundary)
+    moments = moments_from_height_map(zp, dx * scale, dy * scale, method="fd", unit="mm")
+    return dict(kind="map", z=z_mm, dx=dx * scale, dy=dy * scale, boundary=boundary,
+                moments=moments)
 
 
-def main(argv=None):
-    ap = argparse.ArgumentParser(description="Statistical vs BEM normal law of one surface",
-                                 allow_abbrev=False)
-    g = ap.add_mutually_exclusive_group()
-    g.add_argument("--surface", default="anisotropic", choices=list(example_surfaces()))
-    g.add_argument("--moments", nargs=5, type=float, metavar=("m00", "m20", "m02", "m40", "m04"),
-                   help="spectral moments, um convention")
-    g.add_argument("--height-map", help=".npy (2D heights) or .npz with key z")
-    ap.add_argument("--dx", type=float, help="height-map step along axis 0, in --unit")
-    ap.add_argument("--dy", type=float, help="step along axis 1 (default dx)")
-    ap.add_argument("--unit", default="um", choices=["um", "mm", "m"])
-    ap.add_argument("--boundary", default="mirror", choices=["periodic", "mirror", "window"])
-    ap.add_argument("--hurst", type=float, default=0.8, help="assumed spectrum (moments only)")
-    ap.add_argument("--plateau", type=float, default=2.0, help="assumed roll-off q_r/q_l")
-    ap.add_argument("--E-star", type=float, default=E_STAR, help="effective modulus [MPa]")
-    ap.add_argument("--nu", type=float, default=NU)
-    ap.add_argument("--psi", type=float, default=0.35, help="plasticity index (69)")
-    ap.add_argument("--no-plastic", action="store_true", help="skip the elasto-plastic laws")
-    ap.add_argument("--tol", type=float, default=0.1, help="agreement tolerance [-]")
-    ap.add_argument("--realisations", type=int, default=8)
-    ap.add_argument("--ppw", type=float, default=8.0, help="pixels per shortest wavelength")
-    ap.add_argument("--periods", type=int, default=1, help="roll-off wavelengths per side")
-    ap.add_argument("--pressures", type=int, default=12)
-    ap.add_argument("--area-range", nargs=2, type=float, default=(0.005, 0.3))
-    ap.add_argument("--backend", default=None, choices=["tamaas", "numpy"])
-    ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--resolution-check", action="store_true",
-                    help="height map: also solve the map sub-sampled by 2 and report the change")
-    ap.add_argument("--out", default="results/compare_laws")
-    args = ap.parse_args(argv)
-    source, label = source_from_args(args)
-    if args.resolution_check:
-        if source["kind"] != "map":
-            raise SystemExit("--resolution-check needs --height-map")
-        r = bem.resolution_check(source["z"], source["dx"], source["dy"], E_star=args.E_star,
-                                 nu=args.nu, boundary=source["boundary"], backend=args.backend)
-        print(f"resolution check (map vs map sub-sampled by 2, elastic BEM): max change of p(h) "
-              f"{r['p']:.2%}, k(h) {r['k']:.2%}, A/A0(h) {r['a']:.2%} (the full map's own "
-              "discretisation error is roughly 2-4x smaller, docs/bem.md)")
-    return compare(source, E_star=args.E_star, nu=args.nu, psi=args.psi, tol=args.tol,
-                   realisations=args.realisations, ppw=args.ppw, periods=args.periods,
-                   n_pressures=args.pressures, area_range=tuple(args.area_range),
-                   backend=args.backend, seed=args.seed, plastic=not args.no_plastic,
-                   out=args.out, label=label)
+def source_from_moments(moments_um, hurst: float = 0.8, plateau: float = 2.0):
+    """The surface as five spectral moments (um convention: m00 um^2, m20, m02 [-], m40, m04
+    um^-2) with the assumed spectrum shape (Hurst exponent [-], roll-off plateau q_r/q_l [-])
+    -> dict(kind="moments", moments, shape) for :func:`compare`."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)
+        m = SpectralMoments(*moments_um, unit="um")
+    return dict(kind="moments", moments=m, shape=SpectrumShape(hurst, plateau))
 
 
-if __name__ == "__main__":
-    main(sys.argv[1:])
+def source_from_example(name: str):
+    """One of :func:`rough_contact.surface.spectrum.example_surfaces` -> source for
+    :func:`compare`."""
+    surfaces = example_surfaces()
+    if name not in surfaces:
+        raise ValueError(f"surface = {name!r} is invalid: valid surfaces are {sorted(surfaces)}")
+    m, shape = surfaces[name]
+    return dict(kind="moments", moments=m, shape=shape)

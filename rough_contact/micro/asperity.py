@@ -36,7 +36,7 @@ from functools import lru_cache
 import numpy as np
 from scipy import special
 
-from .validation import check_scalar
+from ..validation import check_scalar
 
 __all__ = [
     "AsperityMaterial", "elliptic_integrals", "eccentricity_from_lambda", "lambda_from_e1",

@@ -36,9 +36,9 @@ from typing import Optional, Protocol, Tuple, Union
 
 import numpy as np
 
-from .surface import (ANISOTROPY_WARN_RATIO, WINDOWS, MomentTensor, SpectralMoments,
+from .moments import (ANISOTROPY_WARN_RATIO, WINDOWS, MomentTensor, SpectralMoments,
                       moment_tensor_from_height_map)
-from .validation import check_scalar
+from ..validation import check_scalar
 
 __all__ = ["HeightMap", "LENGTH_UNITS", "MIN_PIXELS", "DETRENDS", "detrend",
            "PowerSpectrum", "AnisotropicGaussianPSD", "synthetic_height_map",

@@ -1,0 +1,165 @@
+"""Projection pairing: every point of the first surface projected along its normal onto the
+second surface (non-matching meshes), optionally again on the deformed surfaces after every
+converged increment (moderate sliding).
+
+The projection kernels are :func:`rough_contact.fem.pairing.geometry.project_points`
+(vectorised Newton on the partner facets' own geometry map, exact on P2 faces); this module
+gathers the second surface, checks that every point found a partner and turns the projection
+into :class:`~rough_contact.fem.pairing.base.Partners`.
+
+Units: mm.
+"""
+
+from __future__ import annotations
+
+from typing import Optional
+
+import numpy as np
+from mpi4py import MPI
+
+from rough_contact.fem.pairing.base import (PairedPoints, Partners, SurfaceContext,
+                                            first_surface_points, local_frames)
+from rough_contact.fem.pairing.facets import GatheredSurface, cmap_element, facet_set
+from rough_contact.fem.pairing.geometry import project_points, tabulate
+from rough_contact.validation import check_scalar
+
+__all__ = ["ProjectionPairing", "SlidingProjectionPairing"]
+
+
+class ProjectionPairing:
+    """Non-matching pairing by normal projection, once at set-up (small sliding).
+
+    Args:
+        second_tag: facet tag of the second surface.
+        search_radius: the largest accepted distance between a first-surface point and its
+            partner along the normal [mm], > 0; default: the largest facet diameter of the first
+            surface. Points without partner within it are an error.
+    """
+
+    def __init__(self, second_tag: int, search_radius: Optional[float] = None):
+        if search_radius is not None:
+            check_scalar("search_radius", search_radius, lo=0.0, unit="mm")
+        self.second_tag = second_tag
+        self.search_radius = search_radius
+        self._ctx: Optional[SurfaceContext] = None
+        self._second: Optional[GatheredSurface] = None
+
+    def pair(self, ctx: SurfaceContext) -> PairedPoints:
+        """Set-up projection of the undeformed surfaces (collective).
+
+        Raises:
+            ValueError (on every rank): points without partner within the search radius, or
+                whose only candidates face the wrong way (count, first coordinates, the
+                nearest distance found).
+        """
+        xq, normal, N1, weights = first_surface_points(ctx)
+        R, jump0 = local_frames(ctx.comm, xq, normal, ctx.grain)
+        comm = ctx.comm
+        n_f, nq = xq.shape[:2]
+        self._ctx = ctx
+        self._second = GatheredSurface.create(ctx.V, ctx.facet_tags, self.second_tag,
+                                              ctx.n_owned_facets)
+        if self.search_radius is None:
+            vx1 = ctx.geo1.vertex_x
+            diam = (np.linalg.norm(vx1[:, :, None] - vx1[:, None], axis=-1).max(initial=0.0)
+                    if n_f else 0.0)
+            self.search_radius = comm.allreduce(float(diam), op=MPI.MAX)
+        x = xq.reshape(-1, 3)
+        proj = project_points(x, R[:, 0, :], self._second.surface, cmap_element(ctx.V.mesh),
+                              self.search_radius)
+        self._check(proj, x)
+        return PairedPoints(facets=ctx.geo1.facets, n_qp=nq, x=x, weights=weights, frames=R,
+                            jump0=jump0, N1=N1, nodes1=ctx.geo1.global_nodes,
+                            partners=self._partners(proj, (n_f, nq)), name="projection")
+
+    # ------------------------------------------------------------------ helpers
+    @staticmethod
+    def _zero_gap(p: Partners) -> Partners:
+        return Partners(N2=p.N2, nodes2=p.nodes2, facet=p.facet, remote=p.remote,
+                        gap0=np.zeros(p.facet.shape), copy_of=p.copy_of)
+
+    def _partners(self, proj, shape) -> Partners:
+        """Partner data of a complete projection onto the gathered second surface."""
+        comm = self._ctx.comm
+        second = self._second
+        owner2, lf2_all, nodes2_all = second.owner, second.local_facet, second.nodes
+        n_close, closure = nodes2_all.shape[1], second.closure
+        lf2 = lf2_all[proj.facet]
+        phi2 = tabulate(self._ctx.V.element.basix_element, 0, proj.X_ref)[0]
+        N2 = np.take_along_axis(phi2, closure[lf2], axis=1)
+        return Partners(N2=N2.reshape(shape + (n_close,)),
+                        nodes2=nodes2_all[proj.facet].reshape(shape + (n_close,)),
+                        facet=proj.facet.reshape(shape),
+                        remote=(owner2[proj.facet] != comm.rank).reshape(shape),
+                        gap0=proj.distance.reshape(shape))
+
+    def _check(self, proj, x, after=""):
+        comm = self._ctx.comm
+        first_tag, second_tag, search_radius = self._ctx.first_tag, self.second_tag, \
+            self.search_radius
+        missing = proj.facet < 0
+        n_missing = comm.allreduce(int(missing.sum()), op=MPI.SUM)
+        if n_missing:
+            n_facing = comm.allreduce(int(proj.facing_failure.sum()), op=MPI.SUM)
+            first = comm.allgather(x[missing][:3].tolist() if missing.any() else [])
+            first = [p for r in first for p in r][:3]
+            nearest = comm.allreduce(float(proj.nearest[missing].min(initial=np.inf)),
+                                     op=MPI.MIN)
+            n_total = comm.allreduce(x.shape[0], op=MPI.SUM)
+            why = (f"{n_facing} of them only found facets of surface {second_tag} that face the "
+                   "same way (the surfaces must face each other: check the tags and the "
+                   "bodies they belong to); " if n_facing else "")
+            found = (f"the nearest partner found along the normal of such a point is "
+                     f"{nearest:.6g} mm away" if np.isfinite(nearest) else
+                     "no facet of the second surface lies on their normals")
+            raise ValueError(
+                f"{after}{n_missing} of {n_total} quadrature points of contact surface "
+                f"{first_tag} have no partner on surface {second_tag} within the search "
+                f"radius {search_radius:.6g} mm along their normal; {why}{found}; first "
+                f"points: {first}. Check that the surfaces overlap and face each other, or "
+                "raise search_radius")
+
+
+class SlidingProjectionPairing(ProjectionPairing):
+    """The projection pairing redone on the deformed surfaces at the start of every increment
+    (moderate sliding; a :class:`~rough_contact.fem.pairing.base.SlidingPairing`). Needs a
+    displacement space of the geometry's degree (the surfaces move exactly with u).
+    """
+
+    def __init__(self, second_tag: int, search_radius: Optional[float] = None):
+        super().__init__(second_tag, search_radius)
+        self._projection = None          # the last re-pairing's projection (None: set-up)
+
+    # ------------------------------------------------------------------ sliding capability
+    def repair(self, u_local: np.ndarray, paired: PairedPoints) -> tuple[Partners, np.ndarray]:
+        """Partners on the surfaces deformed by ``u_local`` (n_nodes, 3) (collective; see
+        :class:`~rough_contact.fem.pairing.base.SlidingPairing`)."""
+        ctx, sec = self._ctx, self._second
+        n_f, nq, n_close = paired.N1.shape
+        x1 = paired.x + np.einsum("fqk,fki->fqi", paired.N1,
+                                  u_local[ctx.geo1.local_nodes]).reshape(-1, 3)
+        u2 = ctx.comm.allgather(u_local[sec.own_local_nodes])
+        u2 = np.concatenate(u2).reshape(-1, n_close, 3) if u2 else np.zeros((0, n_close, 3))
+        cell_x = sec.surface.cell_x.copy()
+        rows = np.arange(cell_x.shape[0])[:, None]
+        cell_x[rows, sec.closure[sec.local_facet]] += u2   # Lagrange: facet = its closure
+        nv = sec.vertex_x.shape[1]
+        surface = facet_set(ctx.V.mesh, cell_x, sec.local_facet, sec.vertex_x + u2[:, :nv])
+        proj = project_points(x1, paired.frames[:, 0, :], surface, cmap_element(ctx.V.mesh),
+                              self.search_radius)
+        self._check(proj, x1, after="after sliding: ")
+        self._projection = proj
+        return self._zero_gap(self._partners(proj, (n_f, nq))), proj.distance
+
+    def state(self) -> object:
+        """The last re-pairing's projection (None: the set-up pairing)."""
+        return self._projection
+
+    def restore(self, state: object) -> Optional[Partners]:
+        """Reinstate :meth:`state`; its partners (zero gap), or None for the set-up pairing."""
+        self._projection = state
+        if state is None:
+            return None
+        n_f = self._ctx.geo1.facets.size
+        nq = self._ctx.rule.nq
+        return self._zero_gap(self._partners(state, (n_f, nq)))

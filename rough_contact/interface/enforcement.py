@@ -1,0 +1,150 @@
+"""Enforcement strategies: how an interface imposes its law's constraints.
+
+Pairing, law and enforcement are independent axes (as in Tribol): the same law — a penalty
+law such as ``SoftplusPenalty`` — can be used
+
+* as it is (:class:`Penalty`): the penalty compliance is part of the answer (for the rough law
+  it is the physical normal compliance of the asperities), one Newton solve per increment;
+* with exact constraints (:class:`AugmentedLagrangian`): Uzawa's iteration on per-point
+  multipliers, lambda <- the converged tractions, one Newton solve per update, until the
+  multipliers stop moving; the law must be a
+  :class:`~rough_contact.interface.contract.MultiplierLaw`.
+
+A strategy is pure numpy and holds no per-point data: the multipliers live in the interface's
+history (:class:`~rough_contact.interface.state.InterfaceHistory`), the global reductions and
+the loop over Newton solves belong to the FE interface and the load stepping
+(``ContactInterface.accept``, ``rough_contact.solver.loading``).
+
+Units: multipliers and tractions [MPa].
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Optional, Protocol, Union, runtime_checkable
+
+import numpy as np
+
+from ..validation import check_scalar
+from .contract import InterfaceLawProtocol, LawResult, MultiplierLaw
+
+__all__ = ["Enforcement", "Penalty", "AugmentedLagrangian", "MultiplierUpdate"]
+
+
+@dataclass(frozen=True)
+class MultiplierUpdate:
+    """The multipliers proposed after a converged Newton solve.
+
+    Attributes:
+        multipliers: (n, 3) new multipliers [MPa].
+        change: (n,) magnitude of each point's change [MPa].
+    """
+
+    multipliers: np.ndarray
+    change: np.ndarray
+
+
+@runtime_checkable
+class Enforcement(Protocol):
+    """What the interface asks of an enforcement strategy."""
+
+    name: str
+
+    def check_law(self, law: InterfaceLawProtocol) -> None:
+        """Raise ``TypeError`` if ``law`` cannot be enforced this way."""
+        ...
+
+    def initial_multipliers(self, n_points: int) -> Optional[np.ndarray]:
+        """(n, 3) virgin multipliers, or None for a strategy without multipliers."""
+        ...
+
+    def law_for(self, law: InterfaceLawProtocol,
+                multipliers: Optional[np.ndarray]) -> InterfaceLawProtocol:
+        """The law as this strategy evaluates it with the committed ``multipliers``."""
+        ...
+
+
+@dataclass(frozen=True)
+class Penalty:
+    """The law as it is: no multipliers, one Newton solve per increment."""
+
+    name: str = "penalty"
+
+    def check_law(self, law: InterfaceLawProtocol) -> None:
+        """Any law can be used as a penalty."""
+
+    def initial_multipliers(self, n_points: int) -> None:
+        """No multipliers."""
+        return None
+
+    def law_for(self, law: InterfaceLawProtocol, multipliers: None) -> InterfaceLawProtocol:
+        """The law itself."""
+        return law
+
+
+@dataclass(frozen=True)
+class AugmentedLagrangian:
+    """Exact contact and stick by Uzawa's augmented-Lagrangian iteration.
+
+    Within one Newton solve the multipliers are fixed (at the start of an increment
+    extrapolated from the last two converged increments by :meth:`extrapolate` with the secant
+    predictor); after the solve the interface proposes lambda <- [p, t_x, t_y] of the converged
+    solution (:meth:`update`); if the largest change over all points and ranks exceeds
+    ``tolerance`` times the largest traction magnitude, the load stepping solves again with
+    them, else it commits. A failed increment restores the multipliers it started from.
+
+    Exact constraints at more points per facet than the surface has nodes per facet lock (the
+    iteration stalls where contact or stick ends): on P1/Q1 use the vertex rule; on P2 a rule
+    of at most 2 points per triangle (the interface warns).
+
+    Args:
+        tolerance: convergence of the multipliers, relative to the largest traction magnitude
+            of the interface (0 < tol < 1) [-]. Keep it above about 1e-8: the Newton solves are
+            accurate to rtol 1e-9 of the step's first residual, and the changes stall there.
+        max_updates: multiplier updates per load increment (>= 1) before the increment counts
+            as not converged (cutback).
+    """
+
+    tolerance: float = 1e-3
+    max_updates: int = 30
+    name: str = "augmented_lagrangian"
+
+    def __post_init__(self) -> None:
+        check_scalar("augmentation tolerance", self.tolerance, lo=0.0, hi=1.0, hi_open=True)
+        if (not isinstance(self.max_updates, (int, np.integer))
+                or isinstance(self.max_updates, bool) or self.max_updates < 1):
+            raise ValueError(f"max_updates = {self.max_updates!r} is invalid: it must be an "
+                             "integer >= 1")
+
+    def check_law(self, law: InterfaceLawProtocol) -> None:
+        """The law must be a MultiplierLaw (its penalty can be shifted)."""
+        if not isinstance(law, MultiplierLaw):
+            raise TypeError(
+                f"the augmented-Lagrangian enforcement needs a law whose penalty can be shifted "
+                f"by multipliers (rough_contact.interface.contract.MultiplierLaw: "
+                f"with_multipliers); {type(law).__name__} is not one")
+
+    def initial_multipliers(self, n_points: int) -> np.ndarray:
+        """Zero multipliers at n_points points."""
+        return np.zeros((int(n_points), 3))
+
+    def law_for(self, law: MultiplierLaw, multipliers: np.ndarray) -> InterfaceLawProtocol:
+        """The law shifted by ``multipliers``."""
+        return law.with_multipliers(multipliers)
+
+    @staticmethod
+    def update(multipliers: np.ndarray, result: LawResult) -> MultiplierUpdate:
+        """lambda_new = [p, t_x, t_y] of ``result`` (pure) and each point's change."""
+        new = np.empty_like(multipliers)
+        new[:, 0] = -result.traction[:, 0]
+        new[:, 1:] = result.traction[:, 1:]
+        return MultiplierUpdate(new, np.linalg.norm(new - multipliers, axis=1))
+
+    @staticmethod
+    def extrapolate(multipliers: np.ndarray, previous: np.ndarray,
+                    ratio: Union[float, np.floating]) -> np.ndarray:
+        """lambda + ratio (lambda - lambda_previous), lambda_N clipped at 0 (pure)."""
+        new = multipliers.copy()
+        new += ratio * (multipliers - previous)
+        new[:, 0] = np.maximum(new[:, 0], 0.0)
+        return new

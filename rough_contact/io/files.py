@@ -1,0 +1,119 @@
+"""Files of one run: atomic writes, and the output folder that holds exactly one run.
+
+* :func:`atomic_write` (and :func:`atomic_write_text`): a temporary file, fsync,
+  ``os.replace``; every file the writers of :mod:`rough_contact.io` write goes through it, so a
+  crash leaves the old file or the new one, never a truncated one.
+* :func:`prepare_output_dir` makes a folder hold exactly one run: it refuses a folder with
+  results of an earlier run unless ``overwrite=True``, and then removes those files (only the
+  files this project's writers produce, ``RUN_OUTPUT_PATTERNS``).
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from typing import Iterable, Sequence, Union
+
+from mpi4py import MPI
+
+from rough_contact.fem.collective import run_on_root
+
+__all__ = ["atomic_write", "atomic_write_text", "OutputExistsError", "RUN_OUTPUT_PATTERNS",
+           "prepare_output_dir", "run_files"]
+
+# Files the project's writers produce in an output folder (ResultWriter: displacement, history,
+# the former point cloud with its per-step .bin files; InterfaceWriter: the surface files), and
+# the temporary files of their atomic writes (``<name>.tmp<pid>``).
+RUN_OUTPUT_PATTERNS = (
+    r"displacement\.xdmf", r"displacement\.h5", r"history\.csv", r"interface\.xdmf",
+    r"interface\.h5", r"interface_points\.xdmf", r"interface_\d{4,}\.bin",
+)
+
+
+class OutputExistsError(FileExistsError, ValueError):
+    """An output folder holds results of an earlier run and ``overwrite`` was not given."""
+
+
+def atomic_write(path: str, content: Union[str, bytes, Iterable[bytes]]) -> None:
+    """Write ``content`` to ``path`` atomically: a temporary file, fsync, ``os.replace``.
+
+    A crash leaves either the old file or the new one, never a truncated one. Every file the
+    output writers write goes through here.
+
+    Args:
+        path: destination.
+        content: text (written as UTF-8, newlines unchanged), bytes, or an iterable of bytes
+            chunks (written one after the other).
+    """
+    if isinstance(content, str):
+        chunks: Iterable[bytes] = [content.encode("utf-8")]
+    elif isinstance(content, (bytes, bytearray)):
+        chunks = [bytes(content)]
+    else:
+        chunks = content
+    tmp = f"{path}.tmp{os.getpid()}"
+    with open(tmp, "wb") as fh:
+        for chunk in chunks:
+            fh.write(chunk)
+        fh.flush()
+        os.fsync(fh.fileno())
+    os.replace(tmp, path)
+
+
+def atomic_write_text(path: str, text: str) -> None:
+    """Write ``text`` to ``path`` atomically (:func:`atomic_write`)."""
+    atomic_write(path, text)
+
+
+def run_files(outdir: str, patterns: Sequence[str]) -> list:
+    """Sorted names of the files in ``outdir`` whose name fully matches one of ``patterns``
+    (regular expressions), or the temporary file of an atomic write of such a name."""
+    if not os.path.isdir(outdir):
+        return []
+    regex = re.compile("|".join(f"(?:{p})(?:\\.tmp\\d+)?" for p in patterns))
+    return sorted(f for f in os.listdir(outdir)
+                  if regex.fullmatch(f) and os.path.isfile(os.path.join(outdir, f)))
+
+
+def prepare_output_dir(outdir: str, comm: MPI.Comm = MPI.COMM_WORLD, overwrite: bool = False,
+                       extra_patterns: Sequence[str] = ()) -> list:
+    """Make ``outdir`` ready for exactly one run (collective).
+
+    Creates the folder. If it holds files a writer of this project produces
+    (``RUN_OUTPUT_PATTERNS``: displacement.xdmf/.h5, history.csv, interface.xdmf/.h5,
+    interface_points.xdmf, interface_NNNN.bin, their temporaries) it raises
+    :class:`OutputExistsError`, or with ``overwrite=True`` removes exactly those files. Other
+    files are never touched.
+
+    Args:
+        outdir: output folder.
+        comm: communicator (rank 0 does the file system work).
+        overwrite: remove the results of an earlier run instead of refusing.
+        extra_patterns: further file-name regular expressions (full match) of the caller's own
+            outputs, e.g. ``r"slip_directions.*\\.png"``.
+
+    Returns:
+        Names of the removed files.
+
+    Raises:
+        OutputExistsError: earlier results present and ``overwrite`` is False.
+    """
+    outdir = os.fspath(outdir)
+    patterns = tuple(RUN_OUTPUT_PATTERNS) + tuple(extra_patterns)
+
+    def act():
+        if os.path.exists(outdir) and not os.path.isdir(outdir):
+            raise ValueError(f"output directory {outdir!r} exists and is not a directory")
+        os.makedirs(outdir, exist_ok=True)
+        found = run_files(outdir, patterns)
+        if found and not overwrite:
+            shown = ", ".join(found[:6]) + (", ..." if len(found) > 6 else "")
+            raise OutputExistsError(
+                f"output directory {outdir!r} holds results of an earlier run ({len(found)} "
+                f"files: {shown}); pass overwrite=True (--overwrite) to replace them, or choose "
+                "another directory")
+        for f in found:
+            os.remove(os.path.join(outdir, f))
+        return found
+
+    return run_on_root(comm, act)
