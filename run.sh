@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Single entry point: set-up on a fresh Debian 12 machine (as root) + the two jobs.
-#   bash run.sh demo [args...]   the main job (flat-punch demo once it exists)
+#   bash run.sh demo [args...]   the main job: the flat-punch demo (demos/demo_flat_punch.py)
 #   bash run.sh test             the test suite: unit tests, FE tests serial and on 2 ranks, demos
 #   bash run.sh setup            only the set-up (idempotent, fast when done)
 #   bash run.sh python ...       run a command with the project's interpreter and environment

@@ -273,7 +273,7 @@ def run_beam(comm, mesh, order, quadrature, steps, rtol, kind):
     edges_x = np.array([-dims["width"] / 2 - 1.0, dims["width"] / 2 + 1.0])
     bins, _, modes = _bin_pressure(comm, interface, edges_x, edges_y,
                                    modes=(dims["width"], dims["half_length"], (1, BEAM_MODES)))
-    res = dict(uN_centre=prof["centre"], uN_end=prof["end"], bins=comm.bcast(bins, root=0),
+    res = dict(uN_centre=prof.centre, uN_end=prof.end, bins=comm.bcast(bins, root=0),
                modes=comm.bcast(modes, root=0),
                num_dofs=problem.num_dofs, n_points=interface.n_points_global, newton=newton,
                max_force_error=max_err, t_mesh=t_mesh, t_law=t_law,

@@ -50,9 +50,9 @@ def main(argv=None):
                 t0 = time.perf_counter()
                 r = hertz.run(contact_size=cs, order=order, quadrature=rule,
                               penalty=args.penalty)
-                b = list(r["band_error"].values())
-                PETSc.Sys.Print(f"{cs:5.3f} {order:2d} {rule:>6} {r['dofs']:7d} {r['P']:8.2f} "
-                                f"{100 * r['a_error']:6.2f}% {100 * r['p0_error']:6.2f}% "
+                b = list(r.band_error.values())
+                PETSc.Sys.Print(f"{cs:5.3f} {order:2d} {rule:>6} {r.dofs:7d} {r.P:8.2f} "
+                                f"{100 * r.a_error:6.2f}% {100 * r.p0_error:6.2f}% "
                                 f"{100 * b[0]:5.1f}% {100 * b[1]:6.1f}% {100 * b[2]:7.1f}% "
                                 f"{100 * b[3]:8.1f}% {time.perf_counter() - t0:6.1f}")
 
@@ -70,13 +70,13 @@ def elastic(args):
                 t0 = time.perf_counter()
                 r = hertz.run_elastic(contact_size=cs, order=order, pairing=pairing,
                                       penalty=args.penalty, quadrature=rule)
-                b = list(r["band_error"].values())
+                b = list(r.band_error.values())
                 PETSc.Sys.Print(f"{cs:5.3f} {order:2d} {pairing[:4] + '/' + rule[:4]:>10} "
-                                f"{r['dofs']:7d} "
-                                f"{r['P']:8.2f} {100 * r['a_error']:6.2f}% "
-                                f"{100 * r['p0_error']:6.2f}% {100 * b[0]:5.1f}% "
+                                f"{r.dofs:7d} "
+                                f"{r.P:8.2f} {100 * r.a_error:6.2f}% "
+                                f"{100 * r.p0_error:6.2f}% {100 * b[0]:5.1f}% "
                                 f"{100 * b[1]:6.1f}% {100 * b[2]:7.1f}% {100 * b[3]:8.1f}% "
-                                f"{r['balance']:8.1e} {time.perf_counter() - t0:6.1f}")
+                                f"{r.balance:8.1e} {time.perf_counter() - t0:6.1f}")
 
 
 if __name__ == "__main__":

@@ -21,6 +21,7 @@ import time
 import numpy as np
 from petsc4py import PETSc
 
+from rough_contact import references
 from rough_contact.scenes import mindlin
 
 E, NU, MU, R, DELTA = 2.0e5, 0.49, 0.3, 10.0, 4e-3
@@ -29,9 +30,9 @@ E, NU, MU, R, DELTA = 2.0e5, 0.49, 0.3, 10.0, 4e-3
 def gross_slide():
     G = E / (2 * (1 + NU))
     Es = E / (1 - NU**2)
-    P = 4 / 3 * Es * np.sqrt(R) * DELTA**1.5
-    a = (3 * P * R / (4 * Es)) ** (1 / 3)
-    return 3 * MU * P * (2 - NU) / (16 * G * a) + MU * P * 4.0 / (G * 2 * 16.0)
+    P = references.hertz_force(DELTA, R, Es)
+    a = references.hertz_radius(P, R, Es)
+    return references.sliding_approach(MU, P, a, G, NU) + MU * P * 4.0 / (G * 2 * 16.0)
 
 
 def _kt(h, kt, kt_scale):
@@ -47,12 +48,12 @@ def stick(levels, kt=None, kt_scale=None):
         r = mindlin.run(contact_size=h, order=2, nu=NU, mu=MU,
                         k_tangential=_kt(h, kt, kt_scale))
         dt = time.perf_counter() - t0
-        q = r["Q"] / (MU * r["P"])
+        q = r.Q / (MU * r.P)
         for i in np.flatnonzero((q > 0.01) & (q < 0.99)):
-            ref = float(mindlin.stick_ratio(r["Q"][i], MU, r["P"][i]))
-            PETSc.Sys.Print(f"{h:6.4f} {h / r['a']:5.3f} {r['dofs']:7d} {q[i]:6.3f} "
-                            f"{r['stick'][i]:7.3f} {ref:7.3f} {r['stick'][i] / ref - 1:+7.3f} "
-                            f"{int(r['newton'].sum()):6d} {dt:6.0f}")
+            ref = float(references.stick_ratio(r.Q[i], MU, r.P[i]))
+            PETSc.Sys.Print(f"{h:6.4f} {h / r.a:5.3f} {r.dofs:7d} {q[i]:6.3f} "
+                            f"{r.stick[i]:7.3f} {ref:7.3f} {r.stick[i] / ref - 1:+7.3f} "
+                            f"{int(r.newton.sum()):6d} {dt:6.0f}")
 
 
 def energy(levels, amplitudes, kt=None, kt_scale=None, ring_size=None, ring_band=(0.8, 1.05),
@@ -69,16 +70,16 @@ def energy(levels, amplitudes, kt=None, kt_scale=None, ring_size=None, ring_band
                             ring_band=tuple(ring_band), width_ratio=width_ratio,
                             augmented=augmented, quadrature_degree=quadrature_degree,
                             verbose=verbose)
-            t, s, Q, D = r["t"], r["slide"], r["Q"], r["dissipation"]
+            t, s, Q, D = r.t, r.slide, r.Q, r.dissipation
             end1 = int(np.argmin(np.abs(t - 2.0)))
             idx = np.arange(end1, t.size)
             W = D[-1] - D[end1]
             Qs = 0.5 * (Q[idx].max() - Q[idx].min())
             loop = float(np.sum(0.5 * (Q[idx][1:] + Q[idx][:-1]) * np.diff(s[idx])))
-            ref = float(mindlin.energy_per_cycle(Qs, MU, r["P"][-1], r["a"], G, NU))
-            PETSc.Sys.Print(f"{h:6.4f} {r['dofs']:7d} {amp:5.2f} {Qs / (MU * r['P'][-1]):6.3f} "
+            ref = float(references.energy_per_cycle(Qs, MU, r.P[-1], r.a, G, NU))
+            PETSc.Sys.Print(f"{h:6.4f} {r.dofs:7d} {amp:5.2f} {Qs / (MU * r.P[-1]):6.3f} "
                             f"{W:10.4e} {loop:10.4e} {ref:10.4e} {W / ref - 1:+7.3f} "
-                            f"{int(r['newton'].sum()):6d} {time.perf_counter() - t0:6.0f}")
+                            f"{int(r.newton.sum()):6d} {time.perf_counter() - t0:6.0f}")
 
 
 def main(argv=None):

@@ -40,6 +40,7 @@ import numpy as np
 
 from rough_contact.micro import population as pop
 from rough_contact.micro.asperity import AsperityMaterial, shape_factors
+from rough_contact.interface.tangential import normal_to_tangential_ratio
 from rough_contact.surface import SpectralMoments
 
 E_STAR = 1.14e5  # MPa
@@ -87,11 +88,6 @@ def print_tables_1_2():
 
 def print_table_3():
     print("\nTable 3: kN/kT (Mindlin, (96)-(97)); B along the tangential force")
-    try:
-        from rough_contact.interface.tangential import normal_to_tangential_ratio
-    except Exception as exc:  # noqa: BLE001 - helper B's module may not exist yet
-        print(f"  not available ({exc.__class__.__name__}: {exc})")
-        return
     print("  B^2/A^2 |  nu=0    paper   rel    |  nu=1/4  paper   rel    |  nu=1/2  paper   rel")
     for row in TABLE3:
         vals = [float(normal_to_tangential_ratio(row[0], nu)) for nu in (0.0, 0.25, 0.5)]

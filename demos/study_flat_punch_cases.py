@@ -37,6 +37,7 @@ import argparse
 import json
 import os
 import time
+from dataclasses import asdict, replace
 
 from mpi4py import MPI
 
@@ -68,20 +69,21 @@ def main(argv=None, comm=MPI.COMM_WORLD):
                        normal_law=args.normal_law, verbose=args.verbose)
         results.append(res)
         if comm.rank == 0:
-            print(f"case ({case}): D_cum peak {res['D_peak']:.4e}, end {res['D_end']:.4e}, "
-                  f"D_lit peak {res['D_literal_peak']:.4e} N mm (quarter); Table 5: "
+            print(f"case ({case}): D_cum peak {res.D_peak:.4e}, end {res.D_end:.4e}, "
+                  f"D_lit peak {res.D_literal_peak:.4e} N mm (quarter); Table 5: "
                   f"{punch.TABLE5['21-node'][case]} / {punch.TABLE5['28-node'][case]}; "
-                  f"{res['num_dofs']} DOFs, {res['n_points']} points, "
-                  f"{res['wall_time']:.1f} s", flush=True)
+                  f"{res.num_dofs} DOFs, {res.n_points} points, "
+                  f"{res.wall_time:.1f} s", flush=True)
     if comm.rank == 0:
         os.makedirs(args.outdir, exist_ok=True)
         os.makedirs(args.figdir, exist_ok=True)
         for res in results:
-            plot_case(res, os.path.join(args.figdir, f"punch_case_{res['case']}.png"))
+            plot_case(res, os.path.join(args.figdir, f"punch_case_{res.case}.png"))
         plot_unloading(results, os.path.join(args.figdir, "punch_unloading.png"))
         table = summary_table(results)
         print(table)
-        keep = [{k: v for k, v in r.items() if k not in ("peak", "end")} for r in results]
+        keep = [{k: v for k, v in asdict(replace(r, peak=None, end=None)).items()
+                 if k not in ("peak", "end")} for r in results]
         with open(os.path.join(args.outdir, "punch_cases.json"), "w") as fh:
             json.dump(dict(args=vars(args), ranks=comm.size, results=keep), fh, indent=1)
         print(f"total wall time {time.perf_counter() - t0:.1f} s on {comm.size} rank(s)")

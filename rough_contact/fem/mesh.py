@@ -463,16 +463,22 @@ def scene_from_gmsh(model, comm: MPI.Comm, *, split_body: str,
     Returns:
         The scene; mesh and tags are distributed over ``comm``.
     """
-    if rigid_plane is not None:
-        point = np.asarray(rigid_plane[0], dtype=np.float64).reshape(3)
-        normal = np.asarray(rigid_plane[1], dtype=np.float64).reshape(3)
-        norm = np.linalg.norm(normal)
-        if not norm > 0:
-            raise ValueError(f"rigid_plane normal {normal} has zero length; must be nonzero")
-        rigid_plane = (point, normal / norm)
+    rigid_plane = _normalised_plane(rigid_plane)
     data = _on_rank(comm, rank, lambda: _read_model(model, split_body, surface_owners))
     return _scene_from_data(data, comm, contact_pair=contact_pair, rigid_plane=rigid_plane,
                             rank=rank, dimensions=dimensions)
+
+
+def _normalised_plane(rigid_plane):
+    """``(point (3,), unit normal (3,))`` of a rigid plane given as (point, normal); None stays."""
+    if rigid_plane is None:
+        return None
+    point = np.asarray(rigid_plane[0], dtype=np.float64).reshape(3)
+    normal = np.asarray(rigid_plane[1], dtype=np.float64).reshape(3)
+    norm = np.linalg.norm(normal)
+    if not norm > 0:
+        raise ValueError(f"rigid_plane normal {normal} has zero length; must be nonzero")
+    return point, normal / norm
 
 
 def _merge_models(parts: list) -> dict:
@@ -505,9 +511,10 @@ def _merge_models(parts: list) -> dict:
 def scene_from_msh_files(paths: typing.Sequence, comm: MPI.Comm, *, contact_pair: tuple,
                          split_bodies: typing.Optional[typing.Sequence[str]] = None,
                          rigid_plane: typing.Optional[tuple] = None, rank: int = 0,
-                         dimensions: typing.Optional[dict] = None) -> Scene:
-    """One scene from several gmsh ``.msh`` files meshed separately (e.g. a flange and a
-    gasket), for a non-matching interface. Collective.
+                         dimensions: typing.Optional[dict] = None,
+                         surface_owners: typing.Optional[dict] = None) -> Scene:
+    """One scene from one or several gmsh ``.msh`` files (several: meshed separately, e.g. a
+    flange and a gasket, for a non-matching interface). Collective.
 
     Each file is read in its own gmsh model (so node, element and entity numbers of different
     files never clash) and must name its physical groups (bodies: dimension 3, surfaces:
@@ -519,6 +526,9 @@ def scene_from_msh_files(paths: typing.Sequence, comm: MPI.Comm, *, contact_pair
         contact_pair: (first contact surface name, second name) — typically one from each file.
         split_bodies: per file, the body whose nodes shared with its other bodies are duplicated
             (a file with one body needs none: default, its first body).
+        surface_owners: surface name -> body name for the groups whose gmsh surfaces touch two
+            bodies of one file (a conforming interface meshed in one file, as
+            ``meshes/flat_punch.py`` writes it; see :func:`scene_from_gmsh`).
 
     Raises:
         ValueError: a missing file, clashing group names/tags, different cell types.
@@ -539,10 +549,11 @@ def scene_from_msh_files(paths: typing.Sequence, comm: MPI.Comm, *, contact_pair
             split = None if split_bodies is None else split_bodies[i]
             if split is None:
                 split = next(iter(_gmsh_groups(gmsh.model, 3)), None)
-            parts.append(_read_model(gmsh.model, split, None))
+            parts.append(_read_model(gmsh.model, split, surface_owners))
             gmsh.model.remove()
         return _merge_models(parts)
 
+    rigid_plane = _normalised_plane(rigid_plane)
     with gmsh_session(comm, rank, "msh_files"):
         data = _on_rank(comm, rank, read)
     return _scene_from_data(data, comm, contact_pair=contact_pair, rigid_plane=rigid_plane,
@@ -852,36 +863,6 @@ def describe(scene: Scene) -> str:
         lines.append(f"  {name:20s} tag {tag:3d}  {kind} {measure_of(scene, name):.6g}  "
                      f"({n} {'cells' if kind == 'volume' else 'facets'})")
     return "\n".join(lines)
-
-
-def scene_cli(builder, float_options, argv=None, description=None) -> Scene:
-    """Command line of a scene builder: build it, print labels and measures, optionally XDMF.
-
-    Args:
-        builder: a collective scene builder (``rough_contact.scenes.meshes.flat_punch.flat_punch`` ...).
-        float_options: names of the builder's float keywords exposed as ``--name`` options
-            (underscores become dashes).
-        argv: arguments (default ``sys.argv[1:]``).
-    """
-    import argparse
-    import logging
-
-    logging.getLogger().setLevel(logging.WARNING)
-    parser = argparse.ArgumentParser(description=description, allow_abbrev=False)
-    for name in float_options:
-        parser.add_argument("--" + name.replace("_", "-"), dest=name, type=float, default=None)
-    parser.add_argument("--order", type=int, default=1)
-    parser.add_argument("--cell-type", default=None, choices=["tetrahedron", "hexahedron"])
-    parser.add_argument("--xdmf", default=None, help="write mesh and tags to this file")
-    opts = parser.parse_args(argv)
-    kwargs = {k: v for k, v in vars(opts).items() if k != "xdmf" and v is not None}
-    scene = builder(**kwargs)
-    text = describe(scene)
-    if scene.mesh.comm.rank == 0:
-        print(text)
-    if opts.xdmf:
-        write_xdmf(scene, opts.xdmf)
-    return scene
 
 
 def generate(model, order: int) -> None:

@@ -15,18 +15,21 @@ from __future__ import annotations
 import logging
 import os
 from dataclasses import dataclass
+from typing import Any, Optional
 
 import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from dolfinx import fem
-
+from rough_contact.fem.boundary import fix, fix_where, surface_nodes
+from rough_contact.fem.compat import element_degree, vector_space
 from rough_contact.fem.contact import ContactInterface
 from rough_contact.fem.mesh import Scene
 from rough_contact.fem.problem import ContactProblem, Material, SurfaceLoad
 from rough_contact.interface.law import InterfaceLaw
 from rough_contact.io import ResultWriter, atomic_write_text, gather_points
+from rough_contact.scenes.defaults import SEATING_STIFFNESS
+from rough_contact.scenes.defaults import quadrature_degree as default_qdeg
 from rough_contact.scenes.meshes.beam import beam_on_base
 from rough_contact.solver.loading import load_path
 from rough_contact.solver.snes import SNESSolver
@@ -135,7 +138,7 @@ class BeamScene:
     """
 
     scene: Scene
-    V: fem.FunctionSpace
+    V: Any
     bcs: list
     bc_mid: object
     n_mid: int
@@ -176,32 +179,24 @@ def build_scene(comm=MPI.COMM_WORLD, mesh_size=40.0, contact_size=5.0, order=2,
         raise ValueError(f"order = {order!r} is invalid: it must be 1 or 2")
     scene = beam_on_base(mesh_size=mesh_size, contact_size=contact_size, order=order,
                          load_half_length=load_half_length, comm=comm)
-    V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", order))
-    fdim = scene.mesh.topology.dim - 1
-    sym = fem.locate_dofs_topological(V.sub(1), fdim,
-                                      scene.facet_tags.find(scene.tag("symmetry_y")))
-    bcs = [fem.dirichletbc(PETSc.ScalarType(0.0), sym, V.sub(1))]
+    V = vector_space(scene.mesh, order)
+    bcs = [fix(V, scene.facet_tags, scene.tag("symmetry_y"), 1)]
     # u_x = 0 at the contact-face nodes on the mid-plane x = 0 (used by the frictionless
     # variant only; exact by the symmetry of the problem about x = 0).
     tol = 1e-6 * scene.dimensions["height"]
-    V0, _ = V.sub(0).collapse()
-    mid = fem.locate_dofs_geometrical(
-        (V.sub(0), V0), lambda x: (np.abs(x[0]) < tol) & (np.abs(x[2]) < tol))
-    n_mid = comm.allreduce(len(mid[0]), op=MPI.SUM)
-    bc_mid = fem.dirichletbc(PETSc.ScalarType(0.0), mid[0], V.sub(0))
-    # Contact-face nodes (owned): coordinates and z-DOF indices, for the deflection profile.
-    imap = V.dofmap.index_map
-    cdofs = fem.locate_dofs_topological(V, fdim, scene.facet_tags.find(scene.tag("contact_beam")))
-    cdofs = cdofs[cdofs < imap.size_local]
+    bc_mid, n_mid = fix_where(V, 0, lambda x: (np.abs(x[0]) < tol) & (np.abs(x[2]) < tol))
+    # Contact-face nodes (owned): coordinates and block indices, for the deflection profile.
+    cdofs, cx = surface_nodes(V, scene.facet_tags, scene.tag("contact_beam"))
     return BeamScene(scene=scene, V=V, bcs=bcs, bc_mid=bc_mid, n_mid=n_mid, contact_nodes=cdofs,
-                     contact_x=V.tabulate_dof_coordinates()[cdofs])
+                     contact_x=cx)
 
 
 def build_case(setup, normal, m00, steps=16, tangential="mindlin", friction="b", prefix="rc_",
                dof_threshold=None, beam_modulus=E1, quadrature_degree=None):
     """Interface, problem and solver of one Table 4 case on a built scene. Collective.
 
-    ``quadrature_degree`` of the facet rule defaults to twice the element order.
+    ``quadrature_degree`` of the facet rule defaults to twice the element order
+    (:func:`rough_contact.scenes.defaults.quadrature_degree`).
     """
     scene, V, bcs = setup.scene, setup.V, list(setup.bcs)
     if friction == "none":
@@ -216,21 +211,109 @@ def build_case(setup, normal, m00, steps=16, tangential="mindlin", friction="b",
     p_seat = INITIAL_FORCE / 2.0 / contact_area
     law = make_law(normal, m00, p_seat, tangential, friction)
     first, _ = scene.contact_pair
-    order = V.ufl_element().degree()
+    order = element_degree(V)
     interface = ContactInterface(V, scene.facet_tags, first, None, law=law,
                                  rigid_plane=scene.rigid_plane, grain_direction=GRAIN,
-                                 quadrature_degree=(2 * order if quadrature_degree is None
+                                 quadrature_degree=(default_qdeg(order)
+                                                    if quadrature_degree is None
                                                     else quadrature_degree), bcs=bcs)
     loads = [SurfaceLoad(scene.tag("load"), force=[0.0, 0.0, -half_force])]
     problem = ContactProblem(V, {scene.tag("beam"): Material(beam_modulus, NU1)}, bcs, loads,
                              cell_tags=scene.cell_tags, facet_tags=scene.facet_tags,
-                             interface=interface, seating_tag=first, seating_stiffness=1e3,
+                             interface=interface, seating_tag=first,
+                             seating_stiffness=SEATING_STIFFNESS,
                              body_cells=[scene.cell_tags.find(scene.tag("beam"))])
     solver = SNESSolver(problem, prefix=prefix, dof_threshold=dof_threshold)
     lam0 = INITIAL_FORCE / TOTAL_FORCE
     factors = [lam0] + [lam0 + (1.0 - lam0) * (i + 1) / steps for i in range(steps)]
     return BeamCase(law=law, interface=interface, problem=problem, solver=solver, factors=factors,
                     p_seat=p_seat, half_force=half_force)
+
+
+@dataclass(frozen=True)
+class DeflectionProfile:
+    """Centre-line deflection of the contact face (:func:`deflection_profile`).
+
+    Attributes:
+        y: (n_samples,) distance from mid-length along the centre line x = 0 [mm].
+        uN: (n_samples,) deflection there [mm] (< 0: approach).
+        centre, end: uN at x = 0 on the edges y = 0 and y = l/2 [mm].
+        centre_mean, end_mean: uN averaged over the width on those edges [mm].
+    """
+
+    y: np.ndarray
+    uN: np.ndarray
+    centre: float
+    end: float
+    centre_mean: float
+    end_mean: float
+
+
+@dataclass(frozen=True)
+class BeamCaseResult:
+    """Result of one Table 4 case (:func:`run_case`); identical on every rank except the point
+    arrays ``points_*``, present on rank 0 only (``None`` elsewhere).
+
+    Attributes:
+        case: Table 4 case number (1-6).
+        m00: height variance of the surface [um^2].
+        normal_law: "elastic" or "elasto-plastic".
+        centre, end: deflection uN at the centre / end of the contact face (x = 0) [mm].
+        centre_mean, end_mean: the same averaged over the width [mm].
+        y, profile: centre-line profile uN(y) [mm] (:class:`DeflectionProfile`).
+        rigid: rigid-beam reference h(F / A0) - h0 of the normal law alone [mm].
+        max_force_error: max relative force-balance error over the increments [-].
+        newton: Newton iterations of all increments.
+        steps: increments solved.
+        contact_force, applied_force: (3,) interface and applied force at the end, half
+            model [N].
+        lifted_area_fraction: nominal area that moved apart (uN > 0) / nominal area [-].
+        lift_from_y: smallest y of a lifted interface point [mm] (inf if none).
+        p_end_min: smallest pressure within 5 mm of the end [MPa].
+        p_max: largest interface pressure [MPa].
+        n_open: interface points without contact.
+        n_below_validity: interface points below the normal law's validity.
+        h0: seated reference separation [mm]; p_seat: seating pressure [MPa].
+        kt_over_kn: (kTx/kN, kTy/kN), ``None`` without friction.
+        friction, hardness: the variant run.
+        num_dofs, n_points: global numbers of DOFs and interface points.
+        wall_time: [s].
+        points_y, points_p, points_uN: interface points sorted by y: y [mm], pressure [MPa],
+            uN [mm] (rank 0).
+    """
+
+    case: int
+    m00: float
+    normal_law: str
+    centre: float
+    end: float
+    centre_mean: float
+    end_mean: float
+    y: np.ndarray
+    profile: np.ndarray
+    rigid: float
+    max_force_error: float
+    newton: int
+    steps: int
+    contact_force: np.ndarray
+    applied_force: np.ndarray
+    lifted_area_fraction: float
+    lift_from_y: float
+    p_end_min: float
+    p_max: float
+    n_open: int
+    n_below_validity: int
+    h0: float
+    p_seat: float
+    kt_over_kn: Optional[tuple]
+    friction: str
+    hardness: str
+    num_dofs: int
+    n_points: int
+    wall_time: float
+    points_y: Optional[np.ndarray] = None
+    points_p: Optional[np.ndarray] = None
+    points_uN: Optional[np.ndarray] = None
 
 
 # ## Deflection along the beam
@@ -252,8 +335,7 @@ def deflection_profile(comm, setup, uN_nodes, n_samples=251):
     interpolant on the nodes.
 
     Returns:
-        dict (on every rank) with y (n_samples,) [mm], uN (n_samples,) [mm], centre, end [mm],
-        centre_mean, end_mean (averages over the width) [mm].
+        :class:`DeflectionProfile` (on every rank).
     """
     pts, fields = gather_points(comm, setup.contact_x, {"uN": uN_nodes})
     out = None
@@ -283,8 +365,8 @@ def deflection_profile(comm, setup, uN_nodes, n_samples=251):
         if bad.any():
             prof[bad] = NearestNDInterpolator(xy, val)(q[bad])
         prof[0], prof[-1] = centre, end
-        out = dict(y=y, uN=prof, centre=centre, end=end, centre_mean=centre_mean,
-                   end_mean=end_mean)
+        out = DeflectionProfile(y=y, uN=prof, centre=centre, end=end, centre_mean=centre_mean,
+                                end_mean=end_mean)
     return comm.bcast(out, root=0)
 
 
@@ -292,11 +374,11 @@ def deflection_profile(comm, setup, uN_nodes, n_samples=251):
 def run_case(comm, setup, case, steps=16, tangential="mindlin", friction="b", hardness="psi",
              outdir="results/beam", prefix="rc_", dof_threshold=None, verbose=True, xdmf=True,
              beam_modulus=E1, overwrite=False):
-    """Load one Table 4 case; return its results. Collective.
+    """Load one Table 4 case; return its :class:`BeamCaseResult`. Collective.
 
-    The result dict is identical on every rank except the point arrays ``points_y``,
-    ``points_p``, ``points_uN`` (interface quadrature points, sorted by y), present on rank 0
-    only. Lengths in mm, pressures in MPa, forces in N.
+    Identical on every rank except the point arrays ``points_y``, ``points_p``, ``points_uN``
+    (interface quadrature points, sorted by y), present on rank 0 only. Lengths in mm,
+    pressures in MPa, forces in N.
     """
     t0 = MPI.Wtime()
     m00, normal_law = CASES[case]
@@ -355,32 +437,33 @@ def run_case(comm, setup, case, steps=16, tangential="mindlin", friction="b", ha
     # rigid-beam reference: a uniform pressure F / A0 on the whole face (no bending)
     p_mean = c.half_force / nominal
     rigid = float(c.law.normal.separation_for_pressure(np.array([p_mean]))[0]) - c.law.h0
-    res = dict(case=case, rigid=rigid, m00=m00, normal_law=normal_law, centre=prof["centre"],
-               end=prof["end"],
-               centre_mean=prof["centre_mean"], end_mean=prof["end_mean"], y=prof["y"],
-               profile=prof["uN"], max_force_error=max_force_error, newton=newton,
-               steps=last.step if last else 0, contact_force=last.contact_force,
-               applied_force=last.applied_force, lifted_area_fraction=area(lifted) / nominal,
-               lift_from_y=y_lift, p_end_min=p_end, p_max=p_max, n_open=n_open,
-               n_below_validity=below, h0=c.law.h0, p_seat=c.p_seat,
-               kt_over_kn=kt, friction=friction, hardness=hardness, num_dofs=problem.num_dofs,
-               n_points=interface.n_points_global, wall_time=MPI.Wtime() - t0)
     # pressure along the beam for the figure (gathered to rank 0)
     pts, fields = gather_points(comm, interface.point_coordinates(),
                                 {"p": pf.pressure, "uN": uN_pts})
+    on_points = {}
     if comm.rank == 0:
         k = np.lexsort((pts[:, 0], pts[:, 1]))
-        res["points_y"], res["points_p"], res["points_uN"] = (pts[k, 1], fields["p"][k],
-                                                             fields["uN"][k])
+        on_points = dict(points_y=pts[k, 1], points_p=fields["p"][k], points_uN=fields["uN"][k])
+    wall_time = MPI.Wtime() - t0
+    res = BeamCaseResult(
+        case=case, rigid=rigid, m00=m00, normal_law=normal_law, centre=prof.centre,
+        end=prof.end, centre_mean=prof.centre_mean, end_mean=prof.end_mean, y=prof.y,
+        profile=prof.uN, max_force_error=max_force_error, newton=newton,
+        steps=last.step if last else 0, contact_force=last.contact_force,
+        applied_force=last.applied_force, lifted_area_fraction=area(lifted) / nominal,
+        lift_from_y=y_lift, p_end_min=p_end, p_max=p_max, n_open=n_open,
+        n_below_validity=below, h0=c.law.h0, p_seat=c.p_seat, kt_over_kn=kt, friction=friction,
+        hardness=hardness, num_dofs=problem.num_dofs, n_points=interface.n_points_global,
+        wall_time=wall_time, **on_points)
     paper = TABLE4[case]
     PETSc.Sys.Print(
-        f"Case {case}: uN centre = {res['centre'] * 1e3:+.3f} um (paper {paper[0]:+.3f}), "
-        f"end = {res['end'] * 1e3:+.3f} um (paper {paper[1]:+.3f}); force balance "
-        f"{max_force_error:.1e}; lifted area {res['lifted_area_fraction'] * 100:.1f} % "
+        f"Case {case}: uN centre = {res.centre * 1e3:+.3f} um (paper {paper[0]:+.3f}), "
+        f"end = {res.end * 1e3:+.3f} um (paper {paper[1]:+.3f}); force balance "
+        f"{max_force_error:.1e}; lifted area {res.lifted_area_fraction * 100:.1f} % "
         + (f"(from y = {y_lift:.1f} mm)" if np.isfinite(y_lift) else "(none)")
         + f"; min p at the end {p_end:.3e} MPa "
         f"(seating {c.p_seat:.3e}); open points {n_open}; {newton} Newton its, "
-        f"{res['wall_time']:.1f} s", comm=comm)
+        f"{res.wall_time:.1f} s", comm=comm)
     solver.destroy()
     return res
 
@@ -397,20 +480,20 @@ def plot_profiles(results, path):
     colors = {0.625: "tab:blue", 0.3125: "tab:orange", 0.0625: "tab:green"}
     markers = {0.625: "s", 0.3125: "x", 0.0625: "^"}  # the paper's symbols
     for r in results:
-        ls = "-" if r["normal_law"] == "elastic" else "--"
-        col = colors.get(r["m00"], "k")
-        ax.plot(r["y"], r["profile"] * 1e3, ls, color=col,
-                label=f"m00 = {r['m00']} um$^2$, {r['normal_law']}")
-        pc, pe = TABLE4[r["case"]]
-        ax.plot([0.0, r["y"][-1]], [pc, pe], markers.get(r["m00"], "o"), color=col,
-                mfc="none" if r["normal_law"] != "elastic" else col, ms=8)
+        ls = "-" if r.normal_law == "elastic" else "--"
+        col = colors.get(r.m00, "k")
+        ax.plot(r.y, r.profile * 1e3, ls, color=col,
+                label=f"m00 = {r.m00} um$^2$, {r.normal_law}")
+        pc, pe = TABLE4[r.case]
+        ax.plot([0.0, r.y[-1]], [pc, pe], markers.get(r.m00, "o"), color=col,
+                mfc="none" if r.normal_law != "elastic" else col, ms=8)
     ax.axhline(0.0, color="0.6", lw=0.8)
     ax.set_xlabel("distance from mid-length y [mm]")
     ax.set_ylabel("interface deflection uN [um]  (< 0: approach)")
     r0 = results[0]
-    variant = f"friction {r0['friction']}"
-    if any(r["normal_law"] != "elastic" for r in results):
-        variant += f", e-p hardness from {r0['hardness']}"
+    variant = f"friction {r0.friction}"
+    if any(r.normal_law != "elastic" for r in results):
+        variant += f", e-p hardness from {r0.hardness}"
     ax.set_title(f"Beam on rigid base: uN at 1962 N relative to the 4.9 N state ({variant})\n"
                  "lines: this code; markers: paper Table 4 (filled elastic, open elasto-plastic)",
                  fontsize=9)
@@ -430,9 +513,9 @@ def plot_pressure(results, path):
 
     fig, ax = plt.subplots(figsize=(7.0, 4.2))
     for r in results:
-        ax.semilogy(r["points_y"], np.maximum(r["points_p"], 1e-12), ".", ms=1.5,
-                    label=f"case {r['case']}: m00 = {r['m00']}, {r['normal_law']}")
-    ax.axhline(results[0]["p_seat"], color="0.5", ls=":", label="seating pressure (4.9 N)")
+        ax.semilogy(r.points_y, np.maximum(r.points_p, 1e-12), ".", ms=1.5,
+                    label=f"case {r.case}: m00 = {r.m00}, {r.normal_law}")
+    ax.axhline(results[0].p_seat, color="0.5", ls=":", label="seating pressure (4.9 N)")
     ax.set_xlabel("distance from mid-length y [mm]")
     ax.set_ylabel("contact pressure p [MPa]")
     ax.set_title("Interface pressure at 1962 N (all quadrature points)", fontsize=9)
@@ -449,12 +532,12 @@ def table(results) -> str:
              "| end - centre [um] | paper | rigid beam [um] | lifted area | force balance |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in results:
-        pc, pe = TABLE4[r["case"]]
-        c, e = r["centre"] * 1e3, r["end"] * 1e3
-        lines.append(f"| {r['case']} | {r['m00']} | {r['normal_law']} | {c:+.3f} | {pc:+.3f} "
+        pc, pe = TABLE4[r.case]
+        c, e = r.centre * 1e3, r.end * 1e3
+        lines.append(f"| {r.case} | {r.m00} | {r.normal_law} | {c:+.3f} | {pc:+.3f} "
                      f"| {e:+.3f} | {pe:+.3f} | {e - c:.3f} | {pe - pc:.3f} "
-                     f"| {r['rigid'] * 1e3:+.3f} "
-                     f"| {r['lifted_area_fraction'] * 100:.1f} % | {r['max_force_error']:.1e} |")
+                     f"| {r.rigid * 1e3:+.3f} "
+                     f"| {r.lifted_area_fraction * 100:.1f} % | {r.max_force_error:.1e} |")
     return "\n".join(lines)
 
 
@@ -464,7 +547,8 @@ def run(cases=tuple(sorted(CASES)), mesh_size=40.0, contact_size=5.0, order=2,
          outdir="results/beam", figdir=None, fig_suffix="", prefix="rc_", dof_threshold=None,
          comm=MPI.COMM_WORLD, verbose=True, plot=True, xdmf=True, beam_modulus=E1,
          overwrite=False):
-    """Run the chosen Table 4 cases; return a list of result dicts (same on every rank).
+    """Run the chosen Table 4 cases; return a list of :class:`BeamCaseResult` (same on every
+    rank but the rank-0 point arrays).
 
     Args:
         cases: Table 4 case numbers (1-6).
@@ -487,8 +571,7 @@ def run(cases=tuple(sorted(CASES)), mesh_size=40.0, contact_size=5.0, order=2,
             limit, a check of the whole chain against the normal law alone.
 
     Returns:
-        list of dicts with keys case, m00, normal_law, centre, end [mm], y, profile [mm],
-        max_force_error, lifted_area_fraction, ... (see ``run_case``).
+        list of :class:`BeamCaseResult`, one per case (see :func:`run_case`).
     """
     cases = [int(k) for k in cases]
     bad = [k for k in cases if k not in CASES]
@@ -514,8 +597,8 @@ def run(cases=tuple(sorted(CASES)), mesh_size=40.0, contact_size=5.0, order=2,
     if comm.rank == 0:
         atomic_write_text(os.path.join(outdir, "table4.md"), text + "\n")
         # centre-line profiles uN(y) [um], one column per case
-        cols = ["y_mm"] + [f"case{r['case']}_uN_um" for r in results]
-        rows = np.column_stack([results[0]["y"]] + [r["profile"] * 1e3 for r in results])
+        cols = ["y_mm"] + [f"case{r.case}_uN_um" for r in results]
+        rows = np.column_stack([results[0].y] + [r.profile * 1e3 for r in results])
         body = "\n".join(",".join(f"{v:.8g}" for v in row) for row in rows)
         atomic_write_text(os.path.join(outdir, "profiles.csv"), ",".join(cols) + "\n" + body + "\n")
         if plot:
@@ -525,7 +608,7 @@ def run(cases=tuple(sorted(CASES)), mesh_size=40.0, contact_size=5.0, order=2,
                 plot_profiles(results, os.path.join(d, f"beam_deflection{fig_suffix}.png"))
                 plot_pressure(results, os.path.join(d, f"beam_pressure{fig_suffix}.png"))
     for r in results:
-        assert r["max_force_error"] < 1e-6, f"force balance violated: {r['max_force_error']:.3e}"
+        assert r.max_force_error < 1e-6, f"force balance violated: {r.max_force_error:.3e}"
     return results
 
 

@@ -19,22 +19,72 @@ Units: mm, N, MPa (the slide given in um at the API).
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from mpi4py import MPI
-
-from dolfinx import fem
 from petsc4py import PETSc
+
+from rough_contact.fem.boundary import fix
+from rough_contact.fem.compat import vector_space
 from rough_contact.fem.contact import ContactInterface
 from rough_contact.fem.problem import (ContactProblem, Material, PrescribedDisplacement,
                                        SurfaceLoad)
 from rough_contact.scenes import flat_punch
+from rough_contact.scenes.defaults import GRAIN_X, SEATING_STIFFNESS, quadrature_degree
 from rough_contact.scenes.meshes.blocks import cylinder_on_block
 from rough_contact.solver.loading import load_path
 from rough_contact.solver.program import LoadProgram
 from rough_contact.solver.snes import SNESSolver
 from rough_contact.validation import check_scalar
 
-__all__ = ["run"]
+__all__ = ["BoltIncrement", "BoltHeadRun", "program", "run"]
+
+
+@dataclass(frozen=True)
+class BoltIncrement:
+    """One converged increment of :func:`run`.
+
+    Attributes:
+        t: pseudo-time (preload over [0, 1], slide over [1, 2]).
+        u_x: prescribed slide of the cylinder's top [mm].
+        F_z: normal force of the block on the cylinder (up) [N].
+        F_x: friction force resisting the slide [N].
+        real_area: real contact area [mm^2].
+        dissipation: cumulative interface dissipation [N mm].
+        slip_fraction: slipping nominal area / nominal area [-].
+        balance: force-balance defect / P [-].
+        newton: Newton iterations spent so far.
+    """
+
+    t: float
+    u_x: float
+    F_z: float
+    F_x: float
+    real_area: float
+    dissipation: float
+    slip_fraction: float
+    balance: float
+    newton: int
+
+
+@dataclass(frozen=True)
+class BoltHeadRun:
+    """Result of :func:`run` (identical on every rank).
+
+    Attributes:
+        P: preload [N].
+        dofs: global number of DOFs.
+        points: global number of interface points.
+        pairing: the pairing used ("mortar", "projection").
+        rows: the increments (:class:`BoltIncrement`).
+    """
+
+    P: float
+    dofs: int
+    points: int
+    pairing: str
+    rows: list
 
 
 def program(preload_steps: int, shear_steps: int) -> LoadProgram:
@@ -49,9 +99,10 @@ def program(preload_steps: int, shear_steps: int) -> LoadProgram:
 
 def run(pressure=10.0, slide_um=2.0, radius=5.0, height=5.0, size_cylinder=1.0,
         size_block=1.6, order=1, pairing="mortar", preload_steps=2, shear_steps=4,
-        comm=MPI.COMM_WORLD, verbose=True) -> dict:
+        comm=MPI.COMM_WORLD, verbose=True) -> BoltHeadRun:
     """Preload the cylinder to ``pressure`` [MPa] nominal on its base, then slide its top by
-    ``slide_um`` [um]. Collective; returns the per-increment table (identical on every rank).
+    ``slide_um`` [um]. Collective; returns the per-increment table (:class:`BoltHeadRun`,
+    identical on every rank).
 
     Raises:
         ValueError: bad sizes or loads (named with their value and range).
@@ -64,15 +115,15 @@ def run(pressure=10.0, slide_um=2.0, radius=5.0, height=5.0, size_cylinder=1.0,
             raise ValueError(f"{name} = {n!r} is invalid: it must be an integer >= 1")
     scene = cylinder_on_block(radius=radius, height=height, size_cylinder=size_cylinder,
                               size_block=size_block, order=order, comm=comm)
-    V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", order))
-    clamp = fem.dirichletbc(np.zeros(3, dtype=PETSc.ScalarType), fem.locate_dofs_topological(
-        V, 2, scene.facet_tags.find(scene.tag("bottom"))), V)
+    V = vector_space(scene.mesh, order)
+    clamp = fix(V, scene.facet_tags, scene.tag("bottom"))
     P = pressure * np.pi * radius**2
     law, _ = flat_punch.make_law(comm, case="b", normal_law="elastic",
                                  seating_pressure=pressure / preload_steps)
     first, second = scene.contact_pair
     interface = ContactInterface(V, scene.facet_tags, first, second, law=law, bcs=[clamp],
-                                 grain_direction=(1.0, 0.0, 0.0), quadrature_degree=2 * order,
+                                 grain_direction=GRAIN_X,
+                                 quadrature_degree=quadrature_degree(order),
                                  pairing=pairing)
     top = scene.tag("cylinder_top")
     prog = program(preload_steps, shear_steps)
@@ -80,7 +131,7 @@ def run(pressure=10.0, slide_um=2.0, radius=5.0, height=5.0, size_cylinder=1.0,
         V, Material(flat_punch.E, flat_punch.NU), [clamp],
         [SurfaceLoad(top, force=(0.0, 0.0, -P), channel="preload")],
         facet_tags=scene.facet_tags, interface=interface, seating_tag=first,
-        seating_stiffness=1e3,
+        seating_stiffness=SEATING_STIFFNESS,
         prescribed=[PrescribedDisplacement(top, (slide, 0.0, 0.0), (0,), channel="shear")],
         programs=prog.channels)
     solver = SNESSolver(problem, prefix="bolt_")
@@ -100,17 +151,17 @@ def run(pressure=10.0, slide_um=2.0, radius=5.0, height=5.0, size_cylinder=1.0,
         balance = max(abs(F[2] + applied_z), abs(F[0] + Rx)) / P
         s = interface.summary()
         # F_z: normal force on the cylinder (up); F_x: friction force resisting the slide
-        row = dict(t=inc.load_factor, u_x=problem.scales["shear"] * slide, F_z=F[2],
-                   F_x=-F[0], real_area=inc.real_area, dissipation=inc.dissipation,
-                   slip_fraction=s.slipping_area / s.nominal_area, balance=balance,
-                   newton=inc.newton_total)
+        row = BoltIncrement(t=inc.load_factor, u_x=problem.scales["shear"] * slide, F_z=F[2],
+                            F_x=-F[0], real_area=inc.real_area, dissipation=inc.dissipation,
+                            slip_fraction=s.slipping_area / s.nominal_area, balance=balance,
+                            newton=inc.newton_total)
         rows.append(row)
         if verbose:
-            PETSc.Sys.Print(f"{row['t']:5.2f} {1e3 * row['u_x']:7.3f} {row['F_z']:9.2f} "
-                            f"{row['F_x']:8.2f} {row['F_x'] / row['F_z']:7.3f} "
-                            f"{100 * row['slip_fraction']:6.1f} {row['real_area']:8.4f} "
-                            f"{row['dissipation']:9.3e} {balance:8.1e} {row['newton']:6d}")
+            PETSc.Sys.Print(f"{row.t:5.2f} {1e3 * row.u_x:7.3f} {row.F_z:9.2f} "
+                            f"{row.F_x:8.2f} {row.F_x / row.F_z:7.3f} "
+                            f"{100 * row.slip_fraction:6.1f} {row.real_area:8.4f} "
+                            f"{row.dissipation:9.3e} {balance:8.1e} {row.newton:6d}")
         assert balance <= 1e-8, f"force balance violated at t = {inc.load_factor}: {balance:.3e}"
     solver.destroy()
-    return dict(P=P, dofs=problem.num_dofs, points=interface.summary().n_points,
-                pairing=interface.pairing_used, rows=rows)
+    return BoltHeadRun(P=P, dofs=problem.num_dofs, points=interface.summary().n_points,
+                       pairing=interface.pairing_used, rows=rows)

@@ -21,19 +21,22 @@ from __future__ import annotations
 import logging
 import os
 from dataclasses import dataclass
-from typing import Optional
+from typing import Any, Optional
 
 import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from dolfinx import fem
-
+from rough_contact.fem.boundary import fix
+from rough_contact.fem.compat import element_degree, vector_space
 from rough_contact.fem.contact import ContactInterface
 from rough_contact.fem.mesh import Scene
 from rough_contact.fem.problem import ContactProblem, Material, SurfaceLoad
 from rough_contact.interface.contract import InterfaceLawProtocol
 from rough_contact.io import ResultWriter, gather_points
+from rough_contact.references import effective_modulus
+from rough_contact.scenes.defaults import GRAIN_X, SEATING_STIFFNESS
+from rough_contact.scenes.defaults import quadrature_degree as default_qdeg
 from rough_contact.scenes.meshes.flat_punch import flat_punch
 from rough_contact.solver.loading import load_path, load_unload_factors
 from rough_contact.solver.snes import SNESSolver
@@ -41,8 +44,7 @@ from rough_contact.validation import check_scalar
 
 __all__ = ["E", "NU", "TOTAL_FORCE", "MOMENTS_UM", "FRICTION_CASES", "HARDENING", "TABLE5",
            "PLASTIC", "effective_modulus", "make_law", "PunchScene", "quarter_punch", "PunchModel",
-           "build", "point_data",
-           "plot_slip_directions", "run"]
+           "build", "point_data", "plot_slip_directions", "PunchResult", "run"]
 
 # Silence the INFO lines of the JIT compiler (setuptools resets the root logger's level).
 logging.getLogger().addFilter(lambda record: record.levelno >= logging.WARNING)
@@ -63,11 +65,6 @@ TABLE5 = {"21-node": {"a": 0.2478, "b": 0.2540, "c": 0.0150},
           "28-node": {"a": 0.2114, "b": 0.1868, "c": 0.0162}}
 # Elasto-plastic asperity data of Figs 18-19 (used with --normal-law elasto-plastic)
 PLASTIC = dict(Y=2070.0, K_Y=1.62, psi=0.35, ch=0.967, omega_p_ratio=45.0)
-
-
-def effective_modulus(E1, nu1, E2, nu2):
-    """E* of eq (42): 1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2 [MPa]."""
-    return 1.0 / ((1.0 - nu1**2) / E1 + (1.0 - nu2**2) / E2)
 
 
 # ## Interface law
@@ -131,7 +128,7 @@ class PunchScene:
     """
 
     scene: Scene
-    V: fem.FunctionSpace
+    V: Any
     bcs: list
 
 
@@ -145,20 +142,10 @@ def quarter_punch(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2
         raise ValueError(f"order = {order!r} is invalid: it must be 1 or 2")
     scene = flat_punch(mesh_size=mesh_size, contact_size=contact_size, order=order,
                        load_half_width=load_half_width, cell_type=cell_type, comm=comm)
-    V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", order))
-    fdim = scene.mesh.topology.dim - 1
-
-    def dofs(name, comp=None):
-        facets = scene.facet_tags.find(scene.tag(name))
-        if comp is None:
-            return fem.locate_dofs_topological(V, fdim, facets)
-        return fem.locate_dofs_topological(V.sub(comp), fdim, facets)
-
-    zero = PETSc.ScalarType(0.0)
-    bcs = [fem.dirichletbc(zero, dofs("symmetry_x", 0), V.sub(0)),
-           fem.dirichletbc(zero, dofs("symmetry_y", 1), V.sub(1)),
-           fem.dirichletbc(np.zeros(3, dtype=PETSc.ScalarType), dofs("fixed"), V)]
-
+    V = vector_space(scene.mesh, order)
+    ft = scene.facet_tags
+    bcs = [fix(V, ft, scene.tag("symmetry_x"), 0), fix(V, ft, scene.tag("symmetry_y"), 1),
+           fix(V, ft, scene.tag("fixed"))]
     return PunchScene(scene, V, bcs)
 
 
@@ -178,7 +165,7 @@ class PunchModel:
     """
 
     scene: Scene
-    V: fem.FunctionSpace
+    V: Any
     law: InterfaceLawProtocol
     normal: Optional[object]
     interface: ContactInterface
@@ -223,7 +210,7 @@ def build(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2, load_h
         punch_scene = quarter_punch(comm, mesh_size, contact_size, order, load_half_width,
                                     cell_type)
     scene, V, bcs = punch_scene.scene, punch_scene.V, punch_scene.bcs
-    order = V.ufl_element().degree()
+    order = element_degree(V)
 
     check_scalar("total_force", total_force, lo=0.0, unit="N")
     quarter_force = total_force / 4.0
@@ -237,15 +224,15 @@ def build(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2, load_h
         interface_law = law
 
     first, second = scene.contact_pair
-    qdeg = quadrature_degree if quadrature_degree is not None else 2 * order
+    qdeg = quadrature_degree if quadrature_degree is not None else default_qdeg(order)
     interface = ContactInterface(V, scene.facet_tags, first, second, law=interface_law,
-                                 grain_direction=(1.0, 0.0, 0.0), quadrature_degree=qdeg,
+                                 grain_direction=GRAIN_X, quadrature_degree=qdeg,
                                  quadrature=quadrature, bcs=bcs, enforcement=enforcement)
     materials = {scene.tag("punch"): Material(E, NU), scene.tag("foundation"): Material(E, NU)}
     loads = [SurfaceLoad(scene.tag("load"), force=[0.0, 0.0, -quarter_force])]
     problem = ContactProblem(V, materials, bcs, loads, cell_tags=scene.cell_tags,
                              facet_tags=scene.facet_tags, interface=interface,
-                             seating_tag=first, seating_stiffness=1e3,
+                             seating_tag=first, seating_stiffness=SEATING_STIFFNESS,
                              body_cells=[scene.cell_tags.find(scene.tag(b)) for b in scene.bodies])
     solver = SNESSolver(problem, prefix=prefix, dof_threshold=dof_threshold,
                         defaults=solver_defaults, **(solver_options or {}))
@@ -289,11 +276,33 @@ def plot_slip_directions(comm, interface, path, title, n_grid=12):
 
 
 # ## The run
+@dataclass(frozen=True)
+class PunchResult:
+    """Result of :func:`run` (identical on every rank).
+
+    Attributes:
+        dissipation: total frictional dissipation D of the quarter model at the end [N mm].
+        history: the converged increments of this call
+            (:class:`rough_contact.solver.loading.Increment`, in order).
+        peak: the increment at the full load (load factor 1), ``None`` if not reached.
+        num_dofs: global number of displacement DOFs.
+        n_points: global number of interface points.
+        max_force_error: max over the increments of |Fz_contact + Fz_applied| / |Fz_applied|.
+    """
+
+    dissipation: float
+    history: list
+    peak: Optional[object]
+    num_dofs: int
+    n_points: int
+    max_force_error: float
+
+
 def run(mesh_size=20.0, contact_size=2.0, order=2, load_half_width=2.5, steps=16,
          unload=True, law="rough", case="b", normal_law="elasto-plastic", outdir="results/flat_punch",
          prefix="rc_", dof_threshold=None, comm=MPI.COMM_WORLD, verbose=True, plot=True,
          overwrite=False, validity="warn", checkpoint=None, restart=None, stop_after=None):
-    """Run the punch; return a dict of results (identical on every rank). Collective.
+    """Run the punch; return a :class:`PunchResult` (identical on every rank). Collective.
 
     ``outdir`` receives one run: earlier results there make it refuse unless ``overwrite``.
     ``validity``: what a converged increment with interface points beyond the normal law's
@@ -342,8 +351,8 @@ def run(mesh_size=20.0, contact_size=2.0, order=2, load_half_width=2.5, steps=16
         PETSc.Sys.Print(f"Nothing left to do: the checkpoint in {restart} is the end of the run; "
                         f"total frictional dissipation D: {D:.4g} N mm", comm=comm)
         solver.destroy()
-        return dict(dissipation=D, history=history, peak=None, num_dofs=problem.num_dofs,
-                    n_points=n_points, max_force_error=0.0)
+        return PunchResult(dissipation=D, history=history, peak=None,
+                           num_dofs=problem.num_dofs, n_points=n_points, max_force_error=0.0)
     if stop_after is not None and history[-1].step < len(factors):
         PETSc.Sys.Print(f"Stopped after {len(history)} increments (stop_after); continue with "
                         f"restart={checkpoint!r} (--restart)", comm=comm)
@@ -368,7 +377,7 @@ def run(mesh_size=20.0, contact_size=2.0, order=2, load_half_width=2.5, steps=16
                     f"slip_directions*.png); wall time {MPI.Wtime() - t0:.1f} s", comm=comm)
     assert max_force_error < 1e-6, f"force balance violated: {max_force_error:.3e}"
     solver.destroy()
-    return dict(dissipation=D, history=history, peak=peak, num_dofs=problem.num_dofs,
-                n_points=n_points, max_force_error=max_force_error)
+    return PunchResult(dissipation=D, history=history, peak=peak, num_dofs=problem.num_dofs,
+                       n_points=n_points, max_force_error=max_force_error)
 
 

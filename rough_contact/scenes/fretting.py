@@ -20,17 +20,20 @@ from __future__ import annotations
 
 import csv
 import os
+from dataclasses import dataclass
 
 import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from dolfinx import fem
+from rough_contact.fem.boundary import fix
+from rough_contact.fem.compat import vector_space
 from rough_contact.fem.contact import ContactInterface
 from rough_contact.fem.problem import (ContactProblem, Material, PrescribedDisplacement,
                                        SurfaceLoad)
 from rough_contact.io import CsvRecorder
 from rough_contact.scenes import flat_punch
+from rough_contact.scenes.defaults import SEATING_STIFFNESS, quadrature_degree
 from rough_contact.scenes.meshes.blocks import two_blocks
 from rough_contact.solver.checkpoint import has_checkpoint
 from rough_contact.solver.loading import load_path
@@ -38,7 +41,7 @@ from rough_contact.solver.program import cycle_summary, preload_then_cyclic
 from rough_contact.solver.snes import SNESSolver
 from rough_contact.validation import check_scalar
 
-__all__ = ["run_amplitude", "run"]
+__all__ = ["FrettingRun", "run_amplitude", "run"]
 
 
 _SCENES: dict = {}   # meshes built by run_amplitude, per parameters and communicator
@@ -47,10 +50,54 @@ LOOP_COLUMNS = ("pseudo_time", "u_x_mm", "F_x_N", "F_z_contact_N", "dissipation_
                 "n_slipping", "n_points", "newton_its_spent")
 
 
+@dataclass(frozen=True)
+class FrettingRun:
+    """Result of :func:`run_amplitude` (identical on every rank). Arrays have one entry per
+    increment of this run (the restarted part included when continued from a checkpoint).
+
+    Attributes:
+        amplitude_um: tangential amplitude a [um].
+        force: preload P [N].
+        dofs: global number of DOFs.
+        t: pseudo-time of each increment (``preload_then_cyclic``).
+        u: prescribed u_x of the top [mm].
+        fx: reaction F_x of the top [N].
+        fz: normal interface force [N].
+        dissipation: cumulative interface dissipation [N mm].
+        slipping: slipping interface points (int).
+        n_points: interface points (int).
+        newton: Newton iterations spent (all increments).
+        cycles: per cycle (``rough_contact.solver.program.cycle_summary``): cycle, loop_energy
+            [N mm], dissipated [N mm], secant_stiffness [N/mm].
+        normal: the tabulated normal law (to reuse for other amplitudes).
+        solved: increments solved by this call.
+        k_normal, k_tangential: interface normal and tangential stiffness at the end of the
+            preload, int dp/dg dA and int dt_x/ds_x dA [N/mm] (nan when a restart skipped the
+            preload).
+    """
+
+    amplitude_um: float
+    force: float
+    dofs: int
+    t: np.ndarray
+    u: np.ndarray
+    fx: np.ndarray
+    fz: np.ndarray
+    dissipation: np.ndarray
+    slipping: np.ndarray
+    n_points: np.ndarray
+    newton: int
+    cycles: list
+    normal: object
+    solved: int
+    k_normal: float
+    k_tangential: float
+
+
 def run_amplitude(amplitude_um: float, *, size=2.0, height=1.0, mesh_size=0.5, order=1,
                   pressure=10.0, cycles=2, steps_per_cycle=16, preload_steps=2, normal=None,
                   comm=MPI.COMM_WORLD, verbose=False, loop_csv=None, checkpoint=None,
-                  restart=None, stop_after=None) -> dict:
+                  restart=None, stop_after=None) -> FrettingRun:
     """Preload to ``pressure`` [MPa] nominal, then ``cycles`` tangential cycles of amplitude
     ``amplitude_um`` [um]. Collective; returns identical results on every rank.
 
@@ -69,22 +116,22 @@ def run_amplitude(amplitude_um: float, *, size=2.0, height=1.0, mesh_size=0.5, o
         _SCENES[key] = two_blocks(lx=size, ly=size, h1=height, h2=height,  # its partition
                                   mesh_size=mesh_size, order=order, comm=comm)
     scene = _SCENES[key]
-    V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", order))
-    clamp = fem.dirichletbc(np.zeros(3, dtype=PETSc.ScalarType), fem.locate_dofs_topological(
-        V, 2, scene.facet_tags.find(scene.tag("bottom"))), V)
+    V = vector_space(scene.mesh, order)
+    clamp = fix(V, scene.facet_tags, scene.tag("bottom"))
     force = pressure * size * size
     law, normal = flat_punch.make_law(comm, case="b", normal_law="elastic",
                                       seating_pressure=pressure / preload_steps, normal=normal)
     first, second = scene.contact_pair
     ci = ContactInterface(V, scene.facet_tags, first, second, law=law, bcs=[clamp],
-                          quadrature_degree=2 * order)
+                          quadrature_degree=quadrature_degree(order))
     top = scene.tag("top")
     prog = preload_then_cyclic(preload_steps, cycles, steps_per_cycle)
     E, NU = flat_punch.E, flat_punch.NU
     problem = ContactProblem(
         V, Material(E, NU), [clamp], [SurfaceLoad(top, force=(0.0, 0.0, -force),
                                                   channel="preload")],
-        facet_tags=scene.facet_tags, interface=ci, seating_tag=first, seating_stiffness=1e3,
+        facet_tags=scene.facet_tags, interface=ci, seating_tag=first,
+        seating_stiffness=SEATING_STIFFNESS,
         prescribed=[PrescribedDisplacement(top, (a, 0.0, 0.0), (0,), channel="cyclic")],
         programs=prog.channels)
     solver = SNESSolver(problem, prefix="fret_")
@@ -101,16 +148,17 @@ def run_amplitude(amplitude_um: float, *, size=2.0, height=1.0, mesh_size=0.5, o
             k_interface = ci.interface_stiffness()
     solver.destroy()
     t, u, fx, fz, d, slip, npts, its = rec.array().T
-    return dict(amplitude_um=amplitude_um, force=force, dofs=problem.num_dofs, t=t, u=u, fx=fx,
-                fz=fz, dissipation=d, slipping=slip.astype(int), n_points=npts.astype(int),
-                newton=int(its.sum()), cycles=cycle_summary(t, prog, u, fx, d), normal=normal,
-                solved=solved, k_normal=float(k_interface[0]), k_tangential=float(k_interface[1]))
+    return FrettingRun(amplitude_um=amplitude_um, force=force, dofs=problem.num_dofs, t=t, u=u,
+                       fx=fx, fz=fz, dissipation=d, slipping=slip.astype(int),
+                       n_points=npts.astype(int), newton=int(its.sum()),
+                       cycles=cycle_summary(t, prog, u, fx, d), normal=normal, solved=solved,
+                       k_normal=float(k_interface[0]), k_tangential=float(k_interface[1]))
 
 
 def run(amplitudes_um=(0.3, 0.5, 0.7, 1.0, 2.0, 4.0), outdir="results/fretting", plot=True,
         comm=MPI.COMM_WORLD, checkpoint=None, restart=None, **kwargs) -> list:
-    """All amplitudes; writes ``cycles.csv``, ``loop_a<amplitude>um.csv`` (per increment) and
-    PNGs in ``outdir``. Collective.
+    """All amplitudes; returns a list of :class:`FrettingRun`; writes ``cycles.csv``,
+    ``loop_a<amplitude>um.csv`` (per increment) and PNGs in ``outdir``. Collective.
 
     ``checkpoint``: directory receiving one checkpoint directory per amplitude; ``restart``: such
     a directory: finished amplitudes are read back from their last checkpoint (no solve), an
@@ -124,16 +172,16 @@ def run(amplitudes_um=(0.3, 0.5, 0.7, 1.0, 2.0, 4.0), outdir="results/fretting",
         again = ck if restart is not None and has_checkpoint(ck, comm) else None
         r = run_amplitude(amp, normal=normal, comm=comm, checkpoint=ck, restart=again,
                           loop_csv=os.path.join(outdir, f"loop_a{amp:g}um.csv"), **kwargs)
-        normal = r["normal"]
-        last = r["cycles"][-1]
+        normal = r.normal
+        last = r.cycles[-1]
         if not results:
-            PETSc.Sys.Print(f"  preloaded joint: interface normal stiffness {r['k_normal']:.4e} "
-                            f"N/mm, tangential {r['k_tangential']:.4e} N/mm (before slip)",
+            PETSc.Sys.Print(f"  preloaded joint: interface normal stiffness {r.k_normal:.4e} "
+                            f"N/mm, tangential {r.k_tangential:.4e} N/mm (before slip)",
                             comm=comm)
-        PETSc.Sys.Print(f"  a = {amp:8.4g} um: {r['dofs']} DOFs, Newton {r['newton']}, energy per "
+        PETSc.Sys.Print(f"  a = {amp:8.4g} um: {r.dofs} DOFs, Newton {r.newton}, energy per "
                         f"cycle {last['loop_energy']:.4e} N mm (interface {last['dissipated']:.4e}), "
                         f"secant stiffness {last['secant_stiffness']:.4e} N/mm, max |Fx|/P "
-                        f"{np.abs(r['fx']).max() / r['force']:.3f}", comm=comm)
+                        f"{np.abs(r.fx).max() / r.force:.3f}", comm=comm)
         results.append(r)
     if comm.rank == 0:
         os.makedirs(outdir, exist_ok=True)
@@ -143,8 +191,8 @@ def run(amplitudes_um=(0.3, 0.5, 0.7, 1.0, 2.0, 4.0), outdir="results/fretting",
             w.writerow(["amplitude_um", "cycle", "loop_energy_Nmm", "dissipated_Nmm",
                         "secant_stiffness_N_per_mm"])
             for r in results:
-                for c in r["cycles"]:
-                    w.writerow([r["amplitude_um"], c["cycle"], c["loop_energy"], c["dissipated"],
+                for c in r.cycles:
+                    w.writerow([r.amplitude_um, c["cycle"], c["loop_energy"], c["dissipated"],
                                 c["secant_stiffness"]])
         os.replace(path + ".tmp", path)
         if plot:
@@ -162,14 +210,14 @@ def _plot(results, outdir):
     FigureCanvasAgg(fig)
     ax0, ax1 = fig.subplots(1, 2)
     for r in results:
-        ax0.plot(r["u"] * 1e3 / r["amplitude_um"], r["fx"] / r["force"], lw=1,
-                 label=f"a = {r['amplitude_um']:g} um")
+        ax0.plot(r.u * 1e3 / r.amplitude_um, r.fx / r.force, lw=1,
+                 label=f"a = {r.amplitude_um:g} um")
     ax0.set_xlabel("u_x / a")
     ax0.set_ylabel("F_x / P")
     ax0.set_title("hysteresis loops (all cycles)", fontsize=9)
     ax0.legend(fontsize=7)
-    amp = np.array([r["amplitude_um"] for r in results])
-    energy = np.array([r["cycles"][-1]["loop_energy"] for r in results])
+    amp = np.array([r.amplitude_um for r in results])
+    energy = np.array([r.cycles[-1]["loop_energy"] for r in results])
     ok = energy > 1e-9 * max(energy.max(initial=0.0), 1e-300)   # round-off loops: no slip
     ax1.loglog(amp[ok], energy[ok], "o-", label="last cycle, loop area")
     if ok.sum() >= 2:
@@ -187,5 +235,5 @@ def _plot(results, outdir):
     ax1.set_title("energy dissipated per cycle vs amplitude", fontsize=9)
     fig.tight_layout()
     fig.savefig(os.path.join(outdir, "fretting.png"), dpi=120)
-    plotting.plot_hysteresis(results[-1]["u"], results[-1]["fx"],
+    plotting.plot_hysteresis(results[-1].u, results[-1].fx,
                              path=os.path.join(outdir, "loop_largest.png"))

@@ -1,20 +1,8 @@
 """Cattaneo–Mindlin and Mindlin–Deresiewicz: a rigid sphere on an elastic block with Coulomb
 friction, normal load then tangential load, against the closed forms.
 
-Closed forms (rigid sphere of radius R on an elastic half-space of shear modulus G and Poisson
-ratio nu; normal force P, Hertz radius a = (3 P R / (4 E*))^(1/3), E* = E / (1 - nu^2); Coulomb
-coefficient mu; tangential force Q rising monotonically from 0; q = Q / (mu P)), valid when the
-normal and tangential problems decouple (nu -> 1/2 for a rigid indenter: the coupling parameter
-(1 - 2 nu) / (2 (1 - nu)) vanishes):
-
-* stick radius c / a = (1 - q)^(1/3) (the slip annulus c < r < a grows from the edge);
-* tangential approach delta(Q) = K [1 - (1 - q)^(2/3)], K = 3 mu P (2 - nu) / (16 G a), whose
-  initial slope is the stiffness of a stuck circular contact, 8 G a / (2 - nu);
-* energy dissipated per full cycle between +Q* and -Q* (Masing's rule applied to delta(Q)):
-  W = 9 mu^2 P^2 (2 - nu) / (10 G a) [1 - (1 - q*)^(5/3) - (5 q* / 6) (1 + (1 - q*)^(2/3))],
-  q* = Q* / (mu P); for small q* it tends to (2 - nu) Q*^3 / (36 G a mu P) (cubic in the
-  amplitude). tests/unit/test_mindlin_closed_forms.py checks W against the numerical loop area
-  of the Masing branches and the cubic limit against the series.
+The closed forms (stick radius, tangential approach, energy per cycle) are in
+:mod:`rough_contact.references`; this module holds the FE scene that is compared with them.
 
 FE scene (``run``): HALF block [-L, L] x [0, L] x [-H, 0] (``indented_block(half=True)``;
 symmetry u_y = 0 on y = 0; the tangential load along x keeps that symmetry), a
@@ -32,68 +20,29 @@ Units: mm, N, MPa.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+from typing import Optional
+
 import numpy as np
 from mpi4py import MPI
-from petsc4py import PETSc
 
-from dolfinx import fem
+from rough_contact.fem.boundary import fix
+from rough_contact.fem.compat import vector_space
 from rough_contact.fem.contact import ContactInterface
 from rough_contact.fem.problem import ContactProblem, Material, PrescribedDisplacement
 from rough_contact.fem.rigid import RigidSphere
 from rough_contact.interface.enforcement import AugmentedLagrangian, Penalty
 from rough_contact.interface.penalty import SoftplusPenalty
+from rough_contact.references import hertz_force, hertz_radius, sliding_approach
+from rough_contact.scenes.defaults import GRAIN_X, INDENTER_PENALTY
+from rough_contact.scenes.defaults import quadrature_degree as default_qdeg
 from rough_contact.scenes.meshes.blocks import indented_block
 from rough_contact.solver.loading import load_path
 from rough_contact.solver.program import LoadProgram
 from rough_contact.solver.snes import SNESSolver
 from rough_contact.validation import check_scalar
 
-__all__ = ["ParaboloidIndenter", "stick_ratio", "tangential_approach", "energy_per_cycle",
-           "energy_per_cycle_small", "run"]
-
-
-def _q(Q, mu, P) -> np.ndarray:
-    P = np.asarray(P, dtype=float)
-    if P.ndim == 0:
-        check_scalar("P", float(P), lo=0.0, unit="N")
-    elif not np.all(np.isfinite(P) & (P > 0.0)):
-        raise ValueError(f"P = {P.min():.6g} N is invalid: it must be finite and > 0")
-    check_scalar("mu", mu, lo=0.0)
-    q = np.abs(np.asarray(Q, dtype=float)) / (mu * P)
-    if np.any(~np.isfinite(q)) or np.any(q > 1.0):
-        raise ValueError(f"Q / (mu P) = {np.max(q):.6g} is invalid: the closed forms need "
-                         "0 <= |Q| <= mu P (beyond it the contact slides)")
-    return q
-
-
-def stick_ratio(Q, mu: float, P: float) -> np.ndarray:
-    """c / a = (1 - Q / (mu P))^(1/3)."""
-    return (1.0 - _q(Q, mu, P)) ** (1.0 / 3.0)
-
-
-def tangential_approach(Q, mu: float, P: float, a: float, G: float, nu: float) -> np.ndarray:
-    """delta(Q) = 3 mu P (2 - nu) / (16 G a) [1 - (1 - Q / (mu P))^(2/3)] [mm]."""
-    q = _q(Q, mu, P)
-    check_scalar("a", a, lo=0.0, unit="mm")
-    check_scalar("G", G, lo=0.0, unit="MPa")
-    return 3.0 * mu * P * (2.0 - nu) / (16.0 * G * a) * (1.0 - (1.0 - q) ** (2.0 / 3.0))
-
-
-def energy_per_cycle(Q_amplitude, mu: float, P: float, a: float, G: float,
-                     nu: float) -> np.ndarray:
-    """Mindlin–Deresiewicz energy per full cycle +-Q* [N mm]."""
-    q = _q(Q_amplitude, mu, P)
-    check_scalar("a", a, lo=0.0, unit="mm")
-    check_scalar("G", G, lo=0.0, unit="MPa")
-    return 9.0 * mu**2 * P**2 * (2.0 - nu) / (10.0 * G * a) * (
-        1.0 - (1.0 - q) ** (5.0 / 3.0) - 5.0 * q / 6.0 * (1.0 + (1.0 - q) ** (2.0 / 3.0)))
-
-
-def energy_per_cycle_small(Q_amplitude, mu: float, P: float, a: float, G: float,
-                           nu: float) -> np.ndarray:
-    """The small-amplitude limit (2 - nu) Q*^3 / (36 G a mu P) [N mm]."""
-    _q(Q_amplitude, mu, P)
-    return (2.0 - nu) * np.abs(Q_amplitude) ** 3 / (36.0 * G * a * mu * P)
+__all__ = ["ParaboloidIndenter", "KT_SCALE", "MindlinRun", "run"]
 
 
 class ParaboloidIndenter:
@@ -143,12 +92,48 @@ def _program(preload_steps: int, shear_steps: int, cycles: int) -> LoadProgram:
                        cycle_start=1.0 if cycles else None)
 
 
+@dataclass(frozen=True)
+class MindlinRun:
+    """Result of :func:`run` (identical on every rank); arrays have one entry per increment.
+
+    Attributes:
+        t: pseudo-time (normal ramp over [0, 1], then the shear).
+        slide: bottom displacement along x [mm].
+        P, Q: total normal and tangential force (twice the half model's bottom reactions) [N].
+        stick: FE stick ratio sqrt(1 - A_slip / A_contact) [-] (nan without contact).
+        contact_area: nominal area with p > 1e-3 p_max (whole contact) [mm^2].
+        dissipation: committed dissipation (whole contact) [N mm].
+        newton: Newton iterations spent up to each increment.
+        a: Hertz's contact radius at the final P [mm].
+        G: shear modulus [MPa]; nu: Poisson ratio; mu: friction coefficient.
+        dofs: global number of DOFs.
+        cycle_start: pseudo-time at which the cycles start (None for a monotonic slide).
+        shear_steps: increments per cycle (or of the monotonic slide).
+    """
+
+    t: np.ndarray
+    slide: np.ndarray
+    P: np.ndarray
+    Q: np.ndarray
+    stick: np.ndarray
+    contact_area: np.ndarray
+    dissipation: np.ndarray
+    newton: np.ndarray
+    a: float
+    G: float
+    nu: float
+    mu: float
+    dofs: int
+    cycle_start: Optional[float]
+    shear_steps: int
+
+
 def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5, nu=0.49,
-        mu=0.3, penalty=1e8, half_width=4.0, height=4.0, mesh_size=1.0, preload_steps=2,
+        mu=0.3, penalty=INDENTER_PENALTY, half_width=4.0, height=4.0, mesh_size=1.0, preload_steps=2,
         shear_steps=12, cycles=0, indenter="paraboloid", quadrature_degree=None,
         k_tangential=None, ring_size=None, ring_band=(0.8, 1.05), width_ratio=1e-3,
         augmented=False, augmentation_tolerance=1e-3, comm=MPI.COMM_WORLD,
-        verbose=False) -> dict:
+        verbose=False) -> MindlinRun:
     """Normal indentation by ``delta`` [mm], then a tangential bottom displacement: monotonic to
     ``slide`` [mm] (``cycles`` = 0) or ``cycles`` triangle cycles of amplitude ``slide``.
 
@@ -182,10 +167,10 @@ def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5
     ``slide`` defaults to the approach at which Mindlin's Q reaches mu P for Hertz's P at
     ``delta`` plus the block's shear compliance (so the last increments slide).
 
-    Returns (identical on every rank): per increment the bottom slide s, the total normal
-    force P and tangential force Q (twice the bottom reactions), the FE stick ratio
-    sqrt(1 - A_slip / A_contact), the contact area, the committed dissipation D (total,
-    twice the half model's); and the scene's constants (a from Hertz at the final P, G, DOFs).
+    Returns:
+        :class:`MindlinRun` (identical on every rank): per increment the bottom slide, P, Q,
+        the FE stick ratio, the contact area, the dissipation; and the scene's constants
+        (a from Hertz at the final P, G, DOFs).
     """
     check_scalar("delta", delta, lo=0.0, unit="mm")
     check_scalar("mu", mu, lo=0.0)
@@ -195,9 +180,9 @@ def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5
     G = E / (2.0 * (1.0 + nu))
     E_star = E / (1.0 - nu**2)
     if slide is None:
-        P_h = 4.0 / 3.0 * E_star * np.sqrt(radius) * delta**1.5
-        a_h = (3.0 * P_h * radius / (4.0 * E_star)) ** (1.0 / 3.0)
-        slide = 3.0 * mu * P_h * (2.0 - nu) / (16.0 * G * a_h) + \
+        P_h = hertz_force(delta, radius, E_star)
+        a_h = hertz_radius(P_h, radius, E_star)
+        slide = sliding_approach(mu, P_h, a_h, G, nu) + \
             mu * P_h * height / (G * 2.0 * half_width * half_width)
     check_scalar("slide", slide, lo=0.0, unit="mm")
     ring = None
@@ -211,9 +196,8 @@ def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5
     scene = indented_block(half_width=half_width, height=height, mesh_size=mesh_size,
                            contact_size=contact_size, transition=1.0, order=order, half=True,
                            ring=ring, comm=comm)
-    V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", order))
-    sym = fem.dirichletbc(PETSc.ScalarType(0.0), fem.locate_dofs_topological(
-        V.sub(1), 2, scene.facet_tags.find(scene.tag("symmetry_y"))), V.sub(1))
+    V = vector_space(scene.mesh, order)
+    sym = fix(V, scene.facet_tags, scene.tag("symmetry_y"), 1)
     if k_tangential is None:
         k_tangential = KT_SCALE * E / contact_size
     check_scalar("k_tangential", k_tangential, lo=0.0, unit="MPa/mm")
@@ -226,8 +210,8 @@ def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5
         RigidSphere((0.0, 0.0, radius), radius)
     ci = ContactInterface(V, scene.facet_tags, scene.tag("contact"), law=law,
                           rigid=rigid, bcs=[sym],
-                          quadrature_degree=2 * order if quadrature_degree is None
-                          else quadrature_degree, grain_direction=(1.0, 0.0, 0.0),
+                          quadrature_degree=default_qdeg(order) if quadrature_degree is None
+                          else quadrature_degree, grain_direction=GRAIN_X,
                           enforcement=enforcement)
     bottom = scene.tag("bottom")
     prog = _program(preload_steps, shear_steps, cycles)
@@ -253,7 +237,7 @@ def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5
                      stick, 2.0 * A_c, 2.0 * inc.dissipation, inc.newton_total))
     solver.destroy()
     t, s, P, Q, stick, area, D, newton = (np.array(c) for c in zip(*rows))
-    a = (3.0 * P[-1] * radius / (4.0 * E_star)) ** (1.0 / 3.0)
-    return dict(t=t, slide=s, P=P, Q=Q, stick=stick, contact_area=area, dissipation=D,
-                newton=newton, a=a, G=G, nu=nu, mu=mu, dofs=problem.num_dofs,
-                cycle_start=prog.cycle_start, shear_steps=shear_steps)
+    return MindlinRun(t=t, slide=s, P=P, Q=Q, stick=stick, contact_area=area, dissipation=D,
+                      newton=newton, a=hertz_radius(P[-1], radius, E_star), G=G, nu=nu, mu=mu,
+                      dofs=problem.num_dofs, cycle_start=prog.cycle_start,
+                      shear_steps=shear_steps)

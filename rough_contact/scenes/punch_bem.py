@@ -13,17 +13,68 @@ level 50 kN (nominal 125 MPa), where the contact pressures lie inside the BEM ta
 from __future__ import annotations
 
 import os
+from dataclasses import astuple, dataclass, fields
 
 import numpy as np
-import ufl
-from dolfinx import fem
 from mpi4py import MPI
 from petsc4py import PETSc
 
+from rough_contact.fem.boundary import SurfaceMean
+from rough_contact.references import effective_modulus
 from rough_contact.scenes import flat_punch as punch
 from rough_contact.solver.loading import load_path, load_unload_factors
 
-__all__ = ["build_laws", "run_with_law", "run"]
+__all__ = ["LawIncrement", "LawComparison", "build_laws", "run_with_law", "run"]
+
+
+@dataclass(frozen=True)
+class LawIncrement:
+    """One converged increment of the punch with one normal law; whole-punch figures
+    (identical on every rank).
+
+    Attributes:
+        force: applied force [N].
+        approach: mean downward displacement of the loaded patch [mm].
+        closure: mean compression of the rough layer, -(mean interface gap) [mm].
+        k_int: int dp/dh dA over the interface [N/mm].
+        real_area: real contact area [mm^2].
+        dissipation: interface dissipation [N mm].
+        below, beyond: interface points below / beyond the normal law's table.
+        p_max: largest interface pressure [MPa].
+        force_error: |Fz_contact + Fz_applied| / |Fz_applied| [-].
+        n_points: global number of interface points.
+    """
+
+    force: float
+    approach: float
+    closure: float
+    k_int: float
+    real_area: float
+    dissipation: float
+    below: int
+    beyond: int
+    p_max: float
+    force_error: float
+    n_points: int
+
+
+@dataclass(frozen=True)
+class LawComparison:
+    """Result of :func:`run`: the increments with each normal law on the same surface.
+
+    Attributes:
+        statistical: increments with the statistical elastic law (:class:`LawIncrement`).
+        bem: increments with the BEM law.
+        num_dofs: global number of DOFs (same mesh for both).
+    """
+
+    statistical: list
+    bem: list
+    num_dofs: int
+
+    def items(self):
+        """(law name, increments) pairs: ("statistical", ...), ("BEM", ...)."""
+        return (("statistical", self.statistical), ("BEM", self.bem))
 
 
 # ## The two normal laws (built on rank 0, copied to the others)
@@ -38,7 +89,7 @@ def build_laws(comm, surface, realisations, ppw, small, backend=None):
         from rough_contact.surface.spectrum import example_surfaces
 
         m, shape = example_surfaces()[surface]
-        E_star = punch.effective_modulus(punch.E, punch.NU, punch.E, punch.NU)
+        E_star = effective_modulus(punch.E, punch.NU, punch.E, punch.NU)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", UserWarning)    # isotropic: model-validity warning
             stat = NormalLaw.elastic(m, E_star)
@@ -53,15 +104,12 @@ def build_laws(comm, surface, realisations, ppw, small, backend=None):
 
 # ## One run of the punch with a given normal law
 def run_with_law(comm, normal, force, steps, case, mesh_size, contact_size, order, verbose):
-    """Load to ``force`` in ``steps`` increments; per-increment figures (identical on ranks)."""
+    """Load to ``force`` in ``steps`` increments; returns (list of :class:`LawIncrement`,
+    number of DOFs), identical on every rank. Collective."""
     m = punch.build(comm, mesh_size, contact_size, order, case=case, normal_law="elastic",
                     steps=steps, normal=normal, total_force=float(force))
     scene, problem, solver, interface, law = m.scene, m.problem, m.solver, m.interface, m.law
-    ds = ufl.Measure("ds", domain=scene.mesh, subdomain_data=scene.facet_tags)
-    load_ds = ds(scene.tag("load"))
-    uz_form = fem.form(problem.u[2] * load_ds)
-    area_load = comm.allreduce(fem.assemble_scalar(fem.form(
-        fem.Constant(scene.mesh, PETSc.ScalarType(1.0)) * load_ds)), op=MPI.SUM)
+    uz_load = SurfaceMean(problem.u, scene.facet_tags, scene.tag("load"), 2)
     rows = []
     for inc in load_path(problem, solver, load_unload_factors(steps, 0), verbose=verbose):
         pf = interface.point_fields()
@@ -70,9 +118,9 @@ def run_with_law(comm, normal, force, steps, case, mesh_size, contact_size, orde
         w = pf.weight
         glob = lambda v: comm.allreduce(float(v), op=MPI.SUM)  # noqa: E731
         area = glob(w.sum())
-        rows.append(dict(
+        rows.append(LawIncrement(
             force=-inc.applied_force[2] * 4.0,                 # full punch [N]
-            approach=-glob(fem.assemble_scalar(uz_form)) / area_load,
+            approach=-uz_load.integral() / uz_load.area,
             closure=-glob(np.dot(pf.gap, w)) / area,          # mean compression of the layer
             k_int=4.0 * glob(np.dot(k, w)),                   # full punch [N/mm]
             real_area=4.0 * glob(np.dot(pf.area_fraction, w)),
@@ -91,7 +139,7 @@ def run_with_law(comm, normal, force, steps, case, mesh_size, contact_size, orde
 def run(surface="anisotropic", force=50e3, steps=8, case="b", mesh_size=20.0, contact_size=2.0,
          order=2, realisations=8, ppw=8.0, small=False, backend=None, outdir=None,
          comm=MPI.COMM_WORLD, verbose=True):
-    """Run both laws; print the comparison; return dict(law -> rows). Collective."""
+    """Run both laws; print the comparison; return a :class:`LawComparison`. Collective."""
     t0 = MPI.Wtime()
     if small:
         mesh_size, contact_size, order, steps = 40.0, 5.0, 1, 2
@@ -104,12 +152,12 @@ def run(surface="anisotropic", force=50e3, steps=8, case="b", mesh_size=20.0, co
                     f"built in {MPI.Wtime() - t0:.1f} s", comm=comm)
     out = {}
     for name, normal in laws.items():
-        rows, ndofs = run_with_law(comm, normal, force, steps, case, mesh_size, contact_size, order,
-                          verbose=False)
+        rows, ndofs = run_with_law(comm, normal, force, steps, case, mesh_size, contact_size,
+                                   order, verbose=False)
         out[name] = rows
-        PETSc.Sys.Print(f"  {name:12s}: {ndofs} DOFs, {rows[-1]['n_points']} interface points, "
+        PETSc.Sys.Print(f"  {name:12s}: {ndofs} DOFs, {rows[-1].n_points} interface points, "
                         f"{len(rows)} increments, max force error "
-                        f"{max(r['force_error'] for r in rows):.1e}", comm=comm)
+                        f"{max(r.force_error for r in rows):.1e}", comm=comm)
     s, b = out["statistical"], out["BEM"]
     PETSc.Sys.Print(f"\nFlat punch, '{surface}' surface, friction case ({case}), loading to "
                     f"{force:g} N in {steps} increments (seated at the first); full-punch "
@@ -122,24 +170,23 @@ def run(surface="anisotropic", force=50e3, steps=8, case="b", mesh_size=20.0, co
     rel = lambda x, y: (y - x) / x if x else float("nan")  # noqa: E731
     for rs, rb in zip(s, b):
         PETSc.Sys.Print(
-            f"{rs['force']:9.4g} | {rs['approach'] * 1e3:6.3f} {rb['approach'] * 1e3:6.3f} "
-            f"{rel(rs['approach'], rb['approach']):+7.1%} | {rs['closure'] * 1e3:6.3f} "
-            f"{rb['closure'] * 1e3:6.3f} {rel(rs['closure'], rb['closure']):+7.1%} | "
-            f"{rs['k_int']:7.3g} {rb['k_int']:7.3g} {rel(rs['k_int'], rb['k_int']):+7.1%} | "
-            f"{rs['real_area']:5.3g} {rb['real_area']:5.3g} "
-            f"{rel(rs['real_area'], rb['real_area']):+7.1%}", comm=comm)
+            f"{rs.force:9.4g} | {rs.approach * 1e3:6.3f} {rb.approach * 1e3:6.3f} "
+            f"{rel(rs.approach, rb.approach):+7.1%} | {rs.closure * 1e3:6.3f} "
+            f"{rb.closure * 1e3:6.3f} {rel(rs.closure, rb.closure):+7.1%} | "
+            f"{rs.k_int:7.3g} {rb.k_int:7.3g} {rel(rs.k_int, rb.k_int):+7.1%} | "
+            f"{rs.real_area:5.3g} {rb.real_area:5.3g} "
+            f"{rel(rs.real_area, rb.real_area):+7.1%}", comm=comm)
     # secant stiffness of the whole punch over the last increment
-    ks = [(r[-1]["force"] - r[-2]["force"]) / (r[-1]["approach"] - r[-2]["approach"])
-          for r in (s, b)]
+    ks = [(r[-1].force - r[-2].force) / (r[-1].approach - r[-2].approach) for r in (s, b)]
     PETSc.Sys.Print(
         f"\nsecant punch stiffness dF/d(approach), last increment: statistical {ks[0]:.4g} N/mm, "
         f"BEM {ks[1]:.4g} N/mm ({rel(ks[0], ks[1]):+.1%})\n"
-        f"dissipation D at {force:g} N: statistical {s[-1]['dissipation']:.4g} N mm, BEM "
-        f"{b[-1]['dissipation']:.4g} N mm ({rel(s[-1]['dissipation'], b[-1]['dissipation']):+.1%})"
-        f"\nlargest contact pressure: statistical {s[-1]['p_max']:.4g} MPa, BEM "
-        f"{b[-1]['p_max']:.4g} MPa; points below the table (continuation) / beyond it (taper) "
-        f"at the peak: statistical {s[-1]['below']}/{s[-1]['beyond']}, BEM "
-        f"{b[-1]['below']}/{b[-1]['beyond']} of {s[-1]['n_points']}\n"
+        f"dissipation D at {force:g} N: statistical {s[-1].dissipation:.4g} N mm, BEM "
+        f"{b[-1].dissipation:.4g} N mm ({rel(s[-1].dissipation, b[-1].dissipation):+.1%})"
+        f"\nlargest contact pressure: statistical {s[-1].p_max:.4g} MPa, BEM "
+        f"{b[-1].p_max:.4g} MPa; points below the table (continuation) / beyond it (taper) "
+        f"at the peak: statistical {s[-1].below}/{s[-1].beyond}, BEM "
+        f"{b[-1].below}/{b[-1].beyond} of {s[-1].n_points}\n"
         f"wall time {MPI.Wtime() - t0:.1f} s", comm=comm)
     if outdir and comm.rank == 0:
         import csv
@@ -147,13 +194,12 @@ def run(surface="anisotropic", force=50e3, steps=8, case="b", mesh_size=20.0, co
         os.makedirs(outdir, exist_ok=True)
         with open(os.path.join(outdir, "history.csv"), "w", newline="") as f:
             w = csv.writer(f)
-            keys = list(s[0])
-            w.writerow(["law"] + keys)
+            w.writerow(["law"] + [f.name for f in fields(LawIncrement)])
             for name, rows in out.items():
                 for r in rows:
-                    w.writerow([name] + [r[k] for k in keys])
+                    w.writerow([name] + list(astuple(r)))
     for rows in out.values():
-        assert max(r["force_error"] for r in rows) < 1e-6, "force balance violated"
-    return out
+        assert max(r.force_error for r in rows) < 1e-6, "force balance violated"
+    return LawComparison(statistical=out["statistical"], bem=out["BEM"], num_dofs=ndofs)
 
 

@@ -58,6 +58,13 @@ def test_demo_flat_punch_rejects_bad_options(tmp_path):
         assert words in proc.stderr, proc.stderr[-2000:]
 
 
+def test_show_scene_mesh(tmp_path):
+    out = run([DEMOS / "show_scene_mesh.py", "flat_punch", "--mesh-size", "40",
+               "--contact-size", "10", "--xdmf", tmp_path / "punch.xdmf"], tmp_path)
+    assert "contact_punch" in out and "area 100" in out
+    assert (tmp_path / "punch.xdmf").exists()
+
+
 def test_demo_beam_rigid_base(tmp_path):
     out = run([DEMOS / "demo_beam_rigid_base.py", "--cases", "1", "--mesh-size", "80",
                "--contact-size", "20", "--order", "1", "--steps", "2", "--no-xdmf",

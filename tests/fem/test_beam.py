@@ -39,25 +39,39 @@ def world(tmp_path_factory):
 def test_force_balance(world):
     """Integrated interface force on the beam equals the applied 981 N (half model)."""
     for r in world:
-        assert r["applied_force"][2] == pytest.approx(-demo.TOTAL_FORCE / 2.0, rel=1e-12)
-        assert abs(r["contact_force"][2] + r["applied_force"][2]) <= 1e-8 * demo.TOTAL_FORCE
-        assert r["max_force_error"] < 1e-8
+        assert r.applied_force[2] == pytest.approx(-demo.TOTAL_FORCE / 2.0, rel=1e-12)
+        assert abs(r.contact_force[2] + r.applied_force[2]) <= 1e-8 * demo.TOTAL_FORCE
+        assert r.max_force_error < 1e-8
         # the x-resultant vanishes by symmetry (the y-resultant is carried by the symmetry plane)
-        assert abs(r["contact_force"][0]) <= 1e-8 * demo.TOTAL_FORCE
+        assert abs(r.contact_force[0]) <= 1e-8 * demo.TOTAL_FORCE
 
 
 def test_deflection_trends(world):
     """Table 4 / Fig 13 trends: the centre approaches more for the rougher surface (larger
     m00), the centre approaches (uN < 0) and the end moves less (uN_end > uN_centre)."""
-    by_case = {r["case"]: r for r in world}
+    by_case = {r.case: r for r in world}
     rough, smooth = by_case[1], by_case[3]
-    assert rough["m00"] > smooth["m00"]
-    assert rough["centre"] < smooth["centre"] < 0.0
+    assert rough.m00 > smooth.m00
+    assert rough.centre < smooth.centre < 0.0
     for r in world:
-        assert r["end"] > r["centre"]
-        # the profile runs from the centre value to the end value
-        assert r["profile"][0] == r["centre"] and r["profile"][-1] == r["end"]
-        assert np.all(np.isfinite(r["profile"]))
+        assert r.end > r.centre
+        assert np.all(np.isfinite(r.profile))
+
+
+def test_profile_matches_the_interface_points(world):
+    """The centre-line profile (nodal u_z, gathered, sorted and interpolated on the nodes)
+    agrees with the deflection at the interface quadrature points (their gap change, computed
+    by the interface from its own shape functions) to 3 % of the profile's range — a wrong
+    sort, a wrong DOF component or a wrong reference state breaks it."""
+    comm = MPI.COMM_WORLD
+    for r in world:
+        worst = None
+        if comm.rank == 0:          # the point arrays are gathered on rank 0
+            along = np.interp(r.points_y, r.y, r.profile)
+            worst = float(np.abs(along - r.points_uN).max() / np.ptp(r.profile))
+        worst = comm.bcast(worst, root=0)
+        assert worst < 0.03, (r.case, worst)
+        assert (r.points_y is None) == (comm.rank != 0)
 
 
 def test_one_vs_two_ranks(world, tmp_path_factory):
@@ -69,11 +83,11 @@ def test_one_vs_two_ranks(world, tmp_path_factory):
     serial = demo.run(cases=(1, 3), outdir=path, comm=MPI.COMM_SELF, prefix="beamself_",
                        **TINY)
     for a, b in zip(world, serial):
-        scale = max(abs(a["centre"]), abs(a["end"]))
+        scale = max(abs(a.centre), abs(a.end))
         for key in ("centre", "end", "centre_mean", "end_mean"):
-            assert abs(a[key] - b[key]) <= 1e-8 * scale, key
-        assert np.max(np.abs(a["profile"] - b["profile"])) <= 1e-8 * scale
-        assert np.allclose(a["contact_force"], b["contact_force"], rtol=0, atol=1e-8 * 981.0)
+            assert abs(getattr(a, key) - getattr(b, key)) <= 1e-8 * scale, key
+        assert np.max(np.abs(a.profile - b.profile)) <= 1e-8 * scale
+        assert np.allclose(a.contact_force, b.contact_force, rtol=0, atol=1e-8 * 981.0)
 
 
 def test_frictionless_ends_lift_more(world, tmp_path_factory):
@@ -83,11 +97,11 @@ def test_frictionless_ends_lift_more(world, tmp_path_factory):
     comm = MPI.COMM_WORLD
     free = demo.run(cases=(1,), friction="none", outdir=_outdir(comm, tmp_path_factory),
                      comm=comm, prefix="beamfree_", **TINY)[0]
-    with_friction = next(r for r in world if r["case"] == 1)
-    assert free["end"] > with_friction["end"]
-    assert free["end"] - free["centre"] > with_friction["end"] - with_friction["centre"]
-    assert abs(free["contact_force"][2] + free["applied_force"][2]) <= 1e-8 * demo.TOTAL_FORCE
-    assert free["kt_over_kn"] is None
+    with_friction = next(r for r in world if r.case == 1)
+    assert free.end > with_friction.end
+    assert free.end - free.centre > with_friction.end - with_friction.centre
+    assert abs(free.contact_force[2] + free.applied_force[2]) <= 1e-8 * demo.TOTAL_FORCE
+    assert free.kt_over_kn is None
 
 
 def test_rigid_beam_limit(tmp_path_factory):
@@ -104,8 +118,8 @@ def test_rigid_beam_limit(tmp_path_factory):
         p_mean = demo.TOTAL_FORCE / 5000.0
         h = law.separation_for_pressure(np.array([p_seat, p_mean]))
         rigid = h[1] - h[0]
-        assert r["rigid"] == pytest.approx(rigid, rel=1e-12)
-        errors.append(max(abs(r["centre"] - rigid), abs(r["end"] - rigid)) / abs(rigid))
+        assert r.rigid == pytest.approx(rigid, rel=1e-12)
+        errors.append(max(abs(r.centre - rigid), abs(r.end - rigid)) / abs(rigid))
     assert errors[1] < 2e-3
     assert errors[1] < 0.2 * errors[0]
 

@@ -29,6 +29,7 @@ from rough_contact.solver.checkpoint import CheckpointError
 from rough_contact.solver.loading import load_path
 from rough_contact.solver.program import preload_then_cyclic
 from rough_contact.solver.snes import SNESSolver
+from rough_contact.scenes.defaults import SEATING_STIFFNESS
 
 PROGRAM = preload_then_cyclic(preload_steps=2, cycles=1, steps_per_cycle=8)
 _NORMAL = {}
@@ -57,7 +58,8 @@ def _model(mesh_size=0.5):
     problem = ContactProblem(
         V, Material(flat_punch.E, flat_punch.NU), [clamp],
         [SurfaceLoad(top, force=(0.0, 0.0, -40.0), channel="preload")],
-        facet_tags=scene.facet_tags, interface=ci, seating_tag=first, seating_stiffness=1e3,
+        facet_tags=scene.facet_tags, interface=ci, seating_tag=first,
+        seating_stiffness=SEATING_STIFFNESS,
         prescribed=[PrescribedDisplacement(top, (2e-3, 0.0, 0.0), (0,), channel="cyclic")],
         programs=PROGRAM.channels)
     return problem, SNESSolver(problem, prefix="ck_")

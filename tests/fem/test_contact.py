@@ -20,6 +20,7 @@ from dolfinx import mesh as dmesh
 from rough_contact.fem.contact import ContactInterface
 from rough_contact.interface.contract import ConvergenceError
 from rough_contact.interface.penalty import LinearPenalty, SoftplusPenalty
+from rough_contact.scenes.meshes import blocks
 
 LOWER_TOP, UPPER_BOTTOM, LOWER_BOTTOM, UPPER_TOP = 1, 2, 3, 4
 KUHN = np.array(
@@ -382,7 +383,7 @@ class _ExponentialNormal:
 @pytest.mark.parametrize("regime", ["stick", "slip"])
 def test_jacobian_finite_difference_rough_law(degree, regime):
     """(b) FD Jacobian with the project's friction law (orthotropic slip hardening)."""
-    law_mod = pytest.importorskip("rough_contact.interface.law")
+    from rough_contact.interface import law as law_mod
     from rough_contact.interface.friction import OrthotropicSlipHardening
     from rough_contact.interface.tangential import TangentialStiffness
 
@@ -409,14 +410,14 @@ def test_jacobian_finite_difference_rough_law(degree, regime):
     assert fd_check(ci, V, x, 1e-8, np.random.default_rng(5)) < 1e-6
 
 
-# ---- scenes from rough_contact/scenes/meshes (gmsh): P2 geometry and hexahedra ---------------------------------
+# ---- scenes from rough_contact/scenes/meshes (gmsh): P2 geometry and hexahedra ----------------
 GMSH_CASES = [("tetrahedron", 1), ("tetrahedron", 2), ("hexahedron", 1), ("hexahedron", 2)]
 
 
 @pytest.mark.parametrize("cell_type,order", GMSH_CASES)
 def test_uniform_jump_patch_gmsh_scene(cell_type, order):
-    """(c) on D1's two_blocks (curved-capable P2 geometry, hexahedra): force = -k d area."""
-    blocks = pytest.importorskip("rough_contact.scenes.meshes.blocks")
+    """(c) on the gmsh two_blocks scene (curved-capable P2 geometry, hexahedra):
+    force = -k d area."""
     lx, ly = 1.0, 0.8
     sc = blocks.two_blocks(lx=lx, ly=ly, h1=0.4, h2=0.4, mesh_size=0.35, order=order,
                            cell_type=cell_type)
@@ -438,8 +439,8 @@ def test_uniform_jump_patch_gmsh_scene(cell_type, order):
 
 @pytest.mark.parametrize("cell_type,order", GMSH_CASES)
 def test_against_ufl_gmsh_block_on_plane(cell_type, order):
-    """(a) on D1's block_on_plane with its rigid plane: same vector and matrix as UFL."""
-    blocks = pytest.importorskip("rough_contact.scenes.meshes.blocks")
+    """(a) on the gmsh block_on_plane scene with its rigid plane: same vector and matrix as
+    UFL."""
     sc = blocks.block_on_plane(lx=1.0, ly=0.7, h=0.5, mesh_size=0.3, order=order,
                                cell_type=cell_type)
     V = fem.VectorFunctionSpace(sc.mesh, ("Lagrange", order))

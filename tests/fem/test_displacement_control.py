@@ -22,6 +22,7 @@ from rough_contact.fem.problem import (ContactProblem, Material, PrescribedDispl
                                        SurfaceLoad)
 from rough_contact.solver.loading import load_path
 from rough_contact.solver.snes import SNESSolver
+from rough_contact.scenes.defaults import SEATING_STIFFNESS
 
 BOTTOM, TOP = 1, 2
 F = np.array([30.0, -20.0, -100.0])       # force on the top at load factor 1 [N]
@@ -113,7 +114,7 @@ def test_punch_pressed_by_displacement_balances_the_interface():
     problem = ContactProblem(
         ps.V, {scene.tag("punch"): Material(E, NU), scene.tag("foundation"): Material(E, NU)},
         ps.bcs, cell_tags=scene.cell_tags, facet_tags=scene.facet_tags, interface=ci,
-        seating_tag=first, seating_stiffness=1e3,
+        seating_tag=first, seating_stiffness=SEATING_STIFFNESS,
         prescribed=[PrescribedDisplacement(load, (0.0, 0.0, -2e-4), (2,))])
     solver = SNESSolver(problem, prefix="dcp_")
     incs = list(load_path(problem, solver, [0.25, 0.5, 1.0], verbose=False))

@@ -30,30 +30,31 @@ def test_stopped_amplitude_continues(tmp_path):
     full = fretting.run_amplitude(2.0, **SMALL)
     ck, loop = _tmp(tmp_path, "ck"), _tmp(tmp_path, "loop.csv")
     part = fretting.run_amplitude(2.0, checkpoint=ck, loop_csv=loop, stop_after=5, **SMALL)
-    assert len(part["t"]) == 5
+    assert len(part.t) == 5
     rest = fretting.run_amplitude(2.0, checkpoint=ck, restart=ck, loop_csv=loop, **SMALL)
-    assert len(rest["t"]) == len(full["t"]) and rest["solved"] == len(full["t"]) - 5
+    assert len(rest.t) == len(full.t) and rest.solved == len(full.t) - 5
     for key in ("t", "u", "fx", "fz", "dissipation"):
-        scale = np.abs(full[key]).max()
-        np.testing.assert_allclose(rest[key], full[key], rtol=0, atol=1e-12 * scale, err_msg=key)
-    assert full["dissipation"][-1] > 0.0                         # it slipped: history matters
+        scale = np.abs(getattr(full, key)).max()
+        np.testing.assert_allclose(getattr(rest, key), getattr(full, key), rtol=0,
+                                   atol=1e-12 * scale, err_msg=key)
+    assert full.dissipation[-1] > 0.0                         # it slipped: history matters
     if MPI.COMM_WORLD.rank == 0:
         with open(loop) as f:
             rows = list(csv.DictReader(f))
-        assert len(rows) == len(full["t"])
-        np.testing.assert_allclose([float(r["F_x_N"]) for r in rows], full["fx"], rtol=1e-11,
-                                   atol=1e-11 * np.abs(full["fx"]).max())
+        assert len(rows) == len(full.t)
+        np.testing.assert_allclose([float(r["F_x_N"]) for r in rows], full.fx, rtol=1e-11,
+                                   atol=1e-11 * np.abs(full.fx).max())
 
 
 def test_driver_restart_reads_finished_amplitudes(tmp_path):
     ck, out = _tmp(tmp_path, "ck"), _tmp(tmp_path, "out")
     first = fretting.run([0.5], outdir=out, plot=False, checkpoint=ck, **SMALL)
     again = fretting.run([0.5, 2.0], outdir=out, plot=False, restart=ck, **SMALL)
-    assert again[0]["solved"] == 0 and first[0]["solved"] == len(first[0]["t"])  # read back
-    np.testing.assert_allclose(again[0]["fx"], first[0]["fx"], rtol=0,
-                               atol=1e-12 * np.abs(first[0]["fx"]).max())
-    assert again[1]["solved"] == len(again[1]["t"]) == len(first[0]["t"])
-    assert again[1]["dissipation"][-1] > again[0]["dissipation"][-1]
+    assert again[0].solved == 0 and first[0].solved == len(first[0].t)  # read back
+    np.testing.assert_allclose(again[0].fx, first[0].fx, rtol=0,
+                               atol=1e-12 * np.abs(first[0].fx).max())
+    assert again[1].solved == len(again[1].t) == len(first[0].t)
+    assert again[1].dissipation[-1] > again[0].dissipation[-1]
     with pytest.raises(ValueError, match="max_steps = 0 is invalid"):
         fretting.run_amplitude(0.5, stop_after=0, **SMALL)
 

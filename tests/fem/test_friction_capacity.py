@@ -21,6 +21,7 @@ from rough_contact.interface.penalty import SoftplusPenalty
 from rough_contact.scenes.meshes.blocks import two_blocks
 from rough_contact.solver.loading import FrictionCapacityError, load_path
 from rough_contact.solver.snes import SNESSolver
+from rough_contact.scenes.defaults import SEATING_STIFFNESS
 
 MU, P = 0.3, 100.0
 TIMES = [0.5, 1.0, 1.25, 1.5, 1.75, 2.0]
@@ -39,7 +40,8 @@ def _model(q_max):
         V, Material(2e5, 0.3), [clamp],
         [SurfaceLoad(top, force=(0.0, 0.0, -P), channel="preload"),
          SurfaceLoad(top, force=(q_max, 0.0, 0.0), channel="shear")],
-        facet_tags=scene.facet_tags, interface=ci, seating_tag=first, seating_stiffness=1e3,
+        facet_tags=scene.facet_tags, interface=ci, seating_tag=first,
+        seating_stiffness=SEATING_STIFFNESS,
         programs={"preload": lambda t: min(t, 1.0), "shear": lambda t: max(t - 1.0, 0.0)})
     return problem, SNESSolver(problem, prefix="fc_")
 

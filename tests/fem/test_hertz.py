@@ -24,11 +24,11 @@ from test_contact import LOWER_TOP, smooth_field, two_blocks  # noqa: E402
 
 def test_sphere_on_block_against_hertz():
     r = hertz.run(contact_size=0.04, order=1, quadrature="vertex", penalty=1e8)
-    assert abs(r["a_error"]) <= 0.03
-    assert abs(r["p0_error"]) <= 0.04
+    assert abs(r.a_error) <= 0.03
+    assert abs(r.p0_error) <= 0.04
     # force balance: the integrated contact pressure carries the bottom reaction
-    assert r["force_from_p"] == pytest.approx(r["P"], rel=2e-4)
-    assert r["band_error"]["0-0.5 a"] <= 0.15
+    assert r.force_from_p == pytest.approx(r.P, rel=2e-4)
+    assert r.band_error["0-0.5 a"] <= 0.15
 
 
 def test_rigid_plane_surface_equals_rigid_plane_argument():
@@ -54,8 +54,8 @@ def test_elastic_sphere_on_separately_meshed_block():
     4 % (the finer levels of benchmarks/bench_hertz.py --elastic converge to -0.07 % / -0.6 %),
     top and bottom reactions balance to the Newton tolerance."""
     r = hertz.run_elastic(contact_size=0.08, order=2, pairing="mortar")
-    assert abs(r["a_error"]) < 0.02
-    assert abs(r["p0_error"]) < 0.04
-    assert r["balance"] < 1e-8
+    assert abs(r.a_error) < 0.02
+    assert abs(r.p0_error) < 0.04
+    assert r.balance < 1e-8
     # int p dA exceeds the axial force P by the tilt of the sphere's normals (cos 1.4 deg at r = a)
-    assert 0.0 <= r["force_from_p"] / r["P"] - 1.0 < 1e-3
+    assert 0.0 <= r.force_from_p / r.P - 1.0 < 1e-3

@@ -37,6 +37,7 @@ from rough_contact.io.interface_output import (
     pseudo_time, read_interface_results)
 from rough_contact.solver.loading import load_path
 from rough_contact.solver.snes import SNESSolver
+from rough_contact.scenes.defaults import SEATING_STIFFNESS
 
 E, NU = 2.0e5, 0.25
 FACTORS = [1.0 / 3.0, 2.0 / 3.0, 1.0]
@@ -101,7 +102,7 @@ def run_punch(comm, outdir, prefix):
         V, {scene.tag("punch"): Material(E, NU), scene.tag("foundation"): Material(E, NU)}, bcs,
         [SurfaceLoad(scene.tag("load"), force=[0.0, 0.0, -QUARTER_FORCE])],
         cell_tags=scene.cell_tags, facet_tags=scene.facet_tags, interface=ci,
-        seating_tag=first, seating_stiffness=1e3)
+        seating_tag=first, seating_stiffness=SEATING_STIFFNESS)
     solver = SNESSolver(problem, prefix=prefix)
     prepare_output_dir(outdir, comm)
     writer = InterfaceWriter(outdir, ci, points=True)

@@ -29,6 +29,7 @@ from rough_contact.scenes.meshes.blocks import two_blocks
 from rough_contact.solver.loading import load_path
 from rough_contact.solver.program import cycle_index, cycle_summary, preload_then_cyclic
 from rough_contact.solver.snes import SNESSolver
+from rough_contact.scenes.defaults import SEATING_STIFFNESS
 
 MU, P, AMPLITUDE = 0.3, 100.0, 3e-3
 
@@ -46,7 +47,8 @@ def _run(steps_per_cycle):
     problem = ContactProblem(
         V, Material(2e5, 0.3), [clamp], [SurfaceLoad(top, force=(0.0, 0.0, -P),
                                                      channel="preload")],
-        facet_tags=scene.facet_tags, interface=ci, seating_tag=first, seating_stiffness=1e3,
+        facet_tags=scene.facet_tags, interface=ci, seating_tag=first,
+        seating_stiffness=SEATING_STIFFNESS,
         prescribed=[PrescribedDisplacement(top, (AMPLITUDE, 0.0, 0.0), (0,), channel="cyclic")],
         programs=program.channels)
     solver = SNESSolver(problem, prefix="lp_")

@@ -18,22 +18,23 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from rough_contact.references import stick_ratio
 from rough_contact.scenes import mindlin
 
 
 def test_cattaneo_mindlin_coarse():
     r = mindlin.run(contact_size=0.05, order=2, shear_steps=6)
-    P, Q, stick = r["P"], r["Q"], r["stick"]
+    P, Q, stick = r.P, r.Q, r.stick
     preload = 2                                   # the first increments are the normal load
     assert np.allclose(P[preload:], P[preload - 1], rtol=2e-3)
-    q = Q / (r["mu"] * P)
+    q = Q / (r.mu * P)
     assert np.all(q <= 1.0 + 1e-9)
     assert q[-1] > 0.99                           # gross slip at the default slide
     assert np.all(np.diff(q[preload - 1:]) > 0) and np.all(np.diff(stick[preload - 1:]) < 0)
     assert stick[preload - 1] > 0.97              # 0.93 with the unscaled k_T = 1e8 MPa/mm
     partial = (q > 0.05) & (q < 0.9)
     assert partial.sum() >= 3
-    ref = mindlin.stick_ratio(Q[partial], r["mu"], P[partial])
+    ref = stick_ratio(Q[partial], r.mu, P[partial])
     assert np.all(np.abs(stick[partial] / ref - 1.0) < 0.03)
 
 

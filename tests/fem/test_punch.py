@@ -70,8 +70,8 @@ def test_demo_main_small(tmp_path):
     res = demo.run(mesh_size=20.0, contact_size=5.0, order=1, steps=2, outdir=outdir, comm=comm,
                     normal_law="elastic",
                     prefix="test_demo_", verbose=False)
-    assert res["max_force_error"] < 1e-8
-    assert len(res["history"]) == 3
+    assert res.max_force_error < 1e-8
+    assert len(res.history) == 3
     if comm.rank == 0:
         for name in ("history.csv", "displacement.xdmf", "displacement.h5", "interface.xdmf",
                      "slip_directions.png", "slip_directions_peak.png"):

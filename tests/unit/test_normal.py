@@ -5,7 +5,6 @@ Greenwood-Williamson integrals, central finite differences, analytic laws.
 """
 from __future__ import annotations
 
-import importlib.util
 import pickle
 import time
 
@@ -337,11 +336,8 @@ def test_from_model_validation():
 
 
 # ----------------------------------------------------------------------------------------------
-# population models of helper A (rough_contact.micro.population)
+# against the population sums (rough_contact.micro.population)
 # ----------------------------------------------------------------------------------------------
-_HAVE_POPULATION = importlib.util.find_spec("rough_contact.micro.population") is not None
-needs_population = pytest.mark.skipif(not _HAVE_POPULATION,
-                                      reason="rough_contact.micro.population not written yet")
 
 
 def _check_against_population(law, direct, rtol, n=40):
@@ -359,7 +355,6 @@ def _check_against_population(law, direct, rtol, n=40):
     assert np.all(np.diff(law.evaluate(np.linspace(law.h_min, law.h_max, 5001))[0]) <= 0)
 
 
-@needs_population
 def test_population_greenwood_williamson():
     from rough_contact.micro import population
     from rough_contact.surface import SpectralMoments
@@ -368,12 +363,11 @@ def test_population_greenwood_williamson():
     law = NormalLaw.greenwood_williamson(surface, E_STAR, rtol=1e-6)
     _check_against_population(law, lambda h: population.greenwood_williamson(surface, E_STAR, h),
                               1e-6, n=2000)
-    # helper A's GW and ours (closed form checked against quad and Table 1) agree
+    # the population's GW sum and the closed form (checked against quad and Table 1) agree
     h = np.linspace(law.h_min, law.h_table_end, 50)
     assert np.allclose(law.evaluate(h)[0], gw(h)[0], rtol=1e-5)
 
 
-@needs_population
 def test_population_elastic():
     from rough_contact.micro import population
     from rough_contact.surface import SpectralMoments
@@ -384,7 +378,6 @@ def test_population_elastic():
         law, lambda h: population.elastic(surface, E_STAR, h, n_quad=16), 1e-3)
 
 
-@needs_population
 def test_population_elasto_plastic():
     from rough_contact.micro import population
     from rough_contact.micro.asperity import AsperityMaterial
@@ -530,7 +523,6 @@ def test_budget_knobs_stop_the_build_with_what_was_reached():
             NormalLaw.from_model(gw, (H_LO, H_HI), **kw)
 
 
-@needs_population
 def test_nearly_degenerate_elasto_plastic_build_ends_with_a_clear_error():
     """Issue 12: Table 1 surface with m00 x 0.2 (mu = 0.0154), psi = 1, rtol 1e-4 refined for
     minutes. Here a coarse population quadrature (n_quad = 12, ~8x cheaper) and the knot budget

@@ -1,4 +1,6 @@
-"""rough_contact.io.plotting: PNGs from tiny data, loop energies against an analytic loop."""
+"""rough_contact.io.plotting: what the figures hold (the data of their lines, collections, colour
+scales and labels, read back from the matplotlib objects), PNGs written, loop energies against
+an analytic loop."""
 
 from __future__ import annotations
 
@@ -35,8 +37,22 @@ def test_import_needs_neither_matplotlib_nor_fe_stack():
 def test_pressure_and_status_maps(tmp_path, cells):
     n = len(POINTS) if cells is None else len(cells)
     values = np.linspace(0.0, 3.0, n)
-    plotting.plot_pressure_map(POINTS, cells, values, title="p", path=tmp_path / "p.png")
+    fig = plotting.plot_pressure_map(POINTS, cells, values, title="p", path=tmp_path / "p.png")
     assert_png(tmp_path / "p.png")
+    ax, cbar_ax = fig.axes
+    (drawn,) = ax.collections
+    # one colour value per facet (per point without cells), in order, scaled to the data range
+    np.testing.assert_array_equal(np.asarray(drawn.get_array()), values)
+    if n > 1:
+        assert (drawn.norm.vmin, drawn.norm.vmax) == (0.0, 3.0)
+    else:                       # one value: a band around it
+        assert drawn.norm.vmin < values[0] < drawn.norm.vmax
+    assert cbar_ax.get_ylabel() == "contact pressure p [MPa]"
+    assert ax.get_title() == "p"
+    if cells is not None:       # the polygons are the facets projected on z = 0
+        paths = [pth.vertices[:len(c)] for pth, c in zip(drawn.get_paths(), cells)]
+        for verts, c in zip(paths, cells):
+            np.testing.assert_array_equal(verts, POINTS[c][:, :2])
     status = np.arange(n) % 3
     fig = plotting.plot_status_map(POINTS, cells, status, path=tmp_path / "s.png")
     assert_png(tmp_path / "s.png")
@@ -61,6 +77,9 @@ def test_uniform_field_and_projection(tmp_path):
     fig = plotting.plot_facet_field(pts, TRIS, np.full(2, 2.0), path=tmp_path / "u.png")
     ax = fig.axes[0]
     assert (ax.get_xlabel(), ax.get_ylabel()) == ("x [mm]", "z [mm]")
+    # a uniform field keeps a non-degenerate colour scale centred on its value
+    norm = ax.collections[0].norm
+    assert norm.vmin < 2.0 < norm.vmax and norm.vmin + norm.vmax == pytest.approx(4.0)
     assert_png(tmp_path / "u.png")
 
 
@@ -103,6 +122,12 @@ def test_loop_energy_equals_parallelogram_area(tmp_path):
     assert_png(tmp_path / "h.png")
     labels = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
     assert len(labels) == 2 and f"{exact:.4g}" in labels[0]
+    # one line per cycle, together covering the whole path (the turning point in both)
+    cycles = [ln for ln in fig.axes[0].get_lines() if ln.get_label().startswith("cycle")]
+    assert len(cycles) == 2
+    np.testing.assert_array_equal(np.concatenate([cycles[0].get_xdata(),
+                                                  cycles[1].get_xdata()[1:]]), u)
+    np.testing.assert_array_equal(cycles[1].get_ydata(), f[b[1]:])
 
 
 def test_split_cycles_with_flat_steps():
@@ -113,9 +138,17 @@ def test_split_cycles_with_flat_steps():
 
 def test_load_displacement(tmp_path):
     u = np.linspace(0, 1e-3, 5)
-    plotting.plot_load_displacement({"P1": (u, 1e5 * u), "P2": (u, 0.9e5 * u)},
-                                    path=tmp_path / "ld.png")
+    fig = plotting.plot_load_displacement({"P1": (u, 1e5 * u), "P2": (u, 0.9e5 * u)},
+                                          ylabel="P [N]", path=tmp_path / "ld.png")
     assert_png(tmp_path / "ld.png")
+    (ax,) = fig.axes
+    lines = ax.get_lines()
+    assert [ln.get_label() for ln in lines] == ["P1", "P2"]       # drawn in the given order
+    for ln, slope in zip(lines, (1e5, 0.9e5)):
+        np.testing.assert_array_equal(ln.get_xdata(), u)
+        np.testing.assert_allclose(ln.get_ydata(), slope * u, rtol=1e-15)
+    assert (ax.get_xlabel(), ax.get_ylabel()) == ("displacement [mm]", "P [N]")
+    assert [t.get_text() for t in ax.get_legend().get_texts()] == ["P1", "P2"]
 
 
 def test_bad_input():

@@ -124,14 +124,3 @@ def beam_on_base(mesh_size: float = 20.0, contact_size: typing.Optional[float] =
         dimensions=dict(width=w, height=hb, length=length, half_length=half,
                         load_half_length=load_half_length, mesh_size=mesh_size,
                         contact_size=contact_size, transition=transition))
-
-
-def main(argv=None) -> None:
-    """Build the scene, print its labels and measures, optionally write XDMF."""
-    from rough_contact.fem.mesh import scene_cli
-
-    scene_cli(beam_on_base, ['mesh_size', 'contact_size', 'load_half_length', 'transition'], argv, description=__doc__.splitlines()[0])
-
-
-if __name__ == "__main__":
-    main()

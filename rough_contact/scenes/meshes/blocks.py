@@ -488,14 +488,3 @@ def indented_block(half_width: float = 4.0, height: float = 4.0, mesh_size: floa
         rigid_plane=(np.zeros(3), np.array([0.0, 0.0, -1.0])),
         dimensions=dict(half_width=half_width, height=height, mesh_size=mesh_size,
                         contact_size=contact_size))
-
-
-def main(argv=None) -> None:
-    """Build the scene, print its labels and measures, optionally write XDMF."""
-    from rough_contact.fem.mesh import scene_cli
-
-    scene_cli(two_blocks, ['mesh_size', 'lx', 'ly', 'h1', 'h2'], argv, description=__doc__.splitlines()[0])
-
-
-if __name__ == "__main__":
-    main()

@@ -163,14 +163,3 @@ def flat_punch(mesh_size: float = 10.0, contact_size: typing.Optional[float] = N
         dimensions=dict(half_width=a, punch_height=hp, foundation_half_width=L,
                         foundation_height=H, load_half_width=b, mesh_size=mesh_size,
                         contact_size=contact_size, transition=transition))
-
-
-def main(argv=None) -> None:
-    """Build the scene, print its labels and measures, optionally write XDMF."""
-    from rough_contact.fem.mesh import scene_cli
-
-    scene_cli(flat_punch, ['mesh_size', 'contact_size', 'load_half_width', 'transition'], argv, description=__doc__.splitlines()[0])
-
-
-if __name__ == "__main__":
-    main()

@@ -1,0 +1,115 @@
+"""Closed-form references: Hertz and Cattaneo–Mindlin / Mindlin–Deresiewicz.
+
+Pure numpy (no DOLFINx, no MPI): the oracles the FE tests, benchmarks and demos compare with,
+and the estimates some scenes use to choose their loads. Nothing here depends on a mesh.
+
+Hertz (a sphere of radius R on an elastic half-space, effective modulus E*; normal force P,
+approach delta): P = 4/3 E* sqrt(R) delta^(3/2); contact radius a^3 = 3 P R / (4 E*); peak
+pressure p0 = 3 P / (2 pi a^2); p(r) = p0 sqrt(1 - r^2 / a^2). For a rigid sphere
+E* = E / (1 - nu^2); for two bodies 1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2
+(:func:`effective_modulus`).
+
+Cattaneo–Mindlin and Mindlin–Deresiewicz (the same contact with Coulomb friction mu, shear
+modulus G, a tangential force Q rising monotonically from 0, q = Q / (mu P)), valid when the
+normal and tangential problems decouple (nu -> 1/2 for a rigid indenter: the coupling
+parameter (1 - 2 nu) / (2 (1 - nu)) vanishes):
+
+* stick radius c / a = (1 - q)^(1/3) (the slip annulus c < r < a grows from the edge);
+* tangential approach delta(Q) = K [1 - (1 - q)^(2/3)], K = 3 mu P (2 - nu) / (16 G a), whose
+  initial slope is the stiffness of a stuck circular contact, 8 G a / (2 - nu);
+* energy dissipated per full cycle between +Q* and -Q* (Masing's rule applied to delta(Q)):
+  W = 9 mu^2 P^2 (2 - nu) / (10 G a) [1 - (1 - q*)^(5/3) - (5 q* / 6) (1 + (1 - q*)^(2/3))],
+  q* = Q* / (mu P); for small q* it tends to (2 - nu) Q*^3 / (36 G a mu P) (cubic in the
+  amplitude). ``tests/unit/test_mindlin_closed_forms.py`` checks W against the numerical loop
+  area of the Masing branches and the cubic limit against the series.
+
+Units: mm, N, MPa.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rough_contact.validation import check_scalar
+
+__all__ = ["effective_modulus", "hertz_force", "hertz_radius", "hertz_peak_pressure",
+           "hertz_pressure", "stick_ratio", "sliding_approach", "tangential_approach",
+           "energy_per_cycle", "energy_per_cycle_small"]
+
+
+# ## Hertz
+def effective_modulus(E1, nu1, E2, nu2):
+    """E* of two elastic bodies: 1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2 [MPa] (paper eq 42;
+    ``E2 = inf`` for a rigid second body)."""
+    return 1.0 / ((1.0 - nu1**2) / E1 + (1.0 - nu2**2) / E2)
+
+
+def hertz_force(delta, radius: float, E_star: float):
+    """Normal force P = 4/3 E* sqrt(R) delta^(3/2) at the approach ``delta`` [N]."""
+    return 4.0 / 3.0 * E_star * np.sqrt(radius) * delta**1.5
+
+
+def hertz_radius(P, radius: float, E_star: float):
+    """Contact radius a = (3 P R / (4 E*))^(1/3) [mm]."""
+    return (3.0 * P * radius / (4.0 * E_star)) ** (1.0 / 3.0)
+
+
+def hertz_peak_pressure(P, a):
+    """Peak pressure p0 = 3 P / (2 pi a^2) [MPa] of the contact radius ``a``."""
+    return 3.0 * P / (2.0 * np.pi * a**2)
+
+
+def hertz_pressure(r, p0, a):
+    """Pressure p(r) = p0 sqrt(1 - r^2 / a^2) inside the contact, 0 outside [MPa]."""
+    return p0 * np.sqrt(np.clip(1.0 - (np.asarray(r) / a) ** 2, 0.0, None))
+
+
+# ## Cattaneo–Mindlin, Mindlin–Deresiewicz
+def _q(Q, mu, P) -> np.ndarray:
+    P = np.asarray(P, dtype=float)
+    if P.ndim == 0:
+        check_scalar("P", float(P), lo=0.0, unit="N")
+    elif not np.all(np.isfinite(P) & (P > 0.0)):
+        raise ValueError(f"P = {P.min():.6g} N is invalid: it must be finite and > 0")
+    check_scalar("mu", mu, lo=0.0)
+    q = np.abs(np.asarray(Q, dtype=float)) / (mu * P)
+    if np.any(~np.isfinite(q)) or np.any(q > 1.0):
+        raise ValueError(f"Q / (mu P) = {np.max(q):.6g} is invalid: the closed forms need "
+                         "0 <= |Q| <= mu P (beyond it the contact slides)")
+    return q
+
+
+def stick_ratio(Q, mu: float, P: float) -> np.ndarray:
+    """c / a = (1 - Q / (mu P))^(1/3) [-]."""
+    return (1.0 - _q(Q, mu, P)) ** (1.0 / 3.0)
+
+
+def sliding_approach(mu: float, P: float, a: float, G: float, nu: float) -> float:
+    """K = 3 mu P (2 - nu) / (16 G a): the tangential approach at which the contact starts to
+    slide (Q = mu P) [mm]."""
+    return 3.0 * mu * P * (2.0 - nu) / (16.0 * G * a)
+
+
+def tangential_approach(Q, mu: float, P: float, a: float, G: float, nu: float) -> np.ndarray:
+    """delta(Q) = 3 mu P (2 - nu) / (16 G a) [1 - (1 - Q / (mu P))^(2/3)] [mm]."""
+    q = _q(Q, mu, P)
+    check_scalar("a", a, lo=0.0, unit="mm")
+    check_scalar("G", G, lo=0.0, unit="MPa")
+    return 3.0 * mu * P * (2.0 - nu) / (16.0 * G * a) * (1.0 - (1.0 - q) ** (2.0 / 3.0))
+
+
+def energy_per_cycle(Q_amplitude, mu: float, P: float, a: float, G: float,
+                     nu: float) -> np.ndarray:
+    """Mindlin–Deresiewicz energy per full cycle +-Q* [N mm]."""
+    q = _q(Q_amplitude, mu, P)
+    check_scalar("a", a, lo=0.0, unit="mm")
+    check_scalar("G", G, lo=0.0, unit="MPa")
+    return 9.0 * mu**2 * P**2 * (2.0 - nu) / (10.0 * G * a) * (
+        1.0 - (1.0 - q) ** (5.0 / 3.0) - 5.0 * q / 6.0 * (1.0 + (1.0 - q) ** (2.0 / 3.0)))
+
+
+def energy_per_cycle_small(Q_amplitude, mu: float, P: float, a: float, G: float,
+                           nu: float) -> np.ndarray:
+    """The small-amplitude limit (2 - nu) Q*^3 / (36 G a mu P) [N mm]."""
+    _q(Q_amplitude, mu, P)
+    return (2.0 - nu) * np.abs(Q_amplitude) ** 3 / (36.0 * G * a * mu * P)
