@@ -28,6 +28,8 @@ from typing import Any, Mapping, Optional, Sequence
 
 import numpy as np
 
+from rough_contact.cycles import loop_energies
+
 __all__ = ["STATUS_COLORS", "plot_facet_field", "plot_pressure_map", "plot_status_map",
            "plot_slip_quiver", "plot_load_displacement", "plot_hysteresis", "loop_energies",
            "split_cycles"]
@@ -359,32 +361,6 @@ def split_cycles(displacement: Sequence[float]) -> np.ndarray:
     # is the point after the last decreasing step
     minima = nonzero[np.flatnonzero((sign[:-1] < 0) & (sign[1:] > 0))] + 1
     return np.unique(np.r_[0, minima, len(u) - 1])
-
-
-def loop_energies(displacement, force, boundaries) -> np.ndarray:
-    """Work of the force on each cycle, the path integral of F du (trapezoidal rule).
-
-    On a closed loop this is the area enclosed, the energy dissipated per cycle when F is the
-    force applied to the body and u its work-conjugate displacement (elastic energy is
-    returned over a closed cycle). The trapezoidal rule is exact for a path that is linear
-    between the recorded increments.
-
-    Args:
-        displacement: (n,) [mm].
-        force: (n,) [N].
-        boundaries: increasing indices, cycle k spans ``[b[k], b[k + 1]]``.
-
-    Returns:
-        (len(boundaries) - 1,) energies [N mm].
-    """
-    u = np.asarray(displacement, dtype=float)
-    f = _values(force, len(u), "force")
-    b = np.asarray(boundaries)
-    if (b.ndim != 1 or len(b) < 2 or not np.issubdtype(b.dtype, np.integer)
-            or np.any(np.diff(b) <= 0) or b[0] < 0 or b[-1] >= len(u)):
-        raise ValueError(f"boundaries {b.tolist()} must be increasing indices in [0, {len(u) - 1}]")
-    work = np.r_[0.0, np.cumsum(0.5 * (f[1:] + f[:-1]) * np.diff(u))]
-    return work[b[1:]] - work[b[:-1]]
 
 
 def plot_hysteresis(displacement, force, *, boundaries=None, energy_unit: str = "N mm",

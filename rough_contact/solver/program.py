@@ -27,6 +27,7 @@ from typing import Callable, Dict, List
 
 import numpy as np
 
+from rough_contact.cycles import loop_energies
 from rough_contact.validation import check_scalar
 
 __all__ = ["LoadProgram", "proportional", "preload_then_hold", "preload_then_cyclic",
@@ -140,7 +141,6 @@ def cycle_summary(times, program: LoadProgram, displacement, force, dissipation)
         equal to the loop energy in a steady cycle), ``secant_stiffness`` ((F_max - F_min) /
         (u_max - u_min) over the cycle [N/mm]).
     """
-    from rough_contact.io.plotting import loop_energies
 
     t = np.asarray(times, dtype=float)
     u = np.asarray(displacement, dtype=float)

@@ -27,29 +27,17 @@ FE_LAYERS = ("fem", "solver", "io", "scenes")
 DOLFINX_ALLOWED = ("rough_contact.fem", "rough_contact.io", "rough_contact.scenes.meshes")
 FE_STACK = {"dolfinx", "ufl", "basix"}
 
-# Modules that still import dolfinx/ufl/basix directly although their layer must not (issue 20,
-# being fixed: they will ask the problem or rough_contact.fem.compat instead). Remove an entry
-# when its module is fixed; the test fails on an entry that no longer imports the FE stack.
-_PENDING_DOLFINX = {
-    "rough_contact.scenes.beam",          # from dolfinx import fem
-    "rough_contact.scenes.bolt_head",     # from dolfinx import fem
-    "rough_contact.scenes.flat_punch",    # from dolfinx import fem
-    "rough_contact.scenes.fretting",      # from dolfinx import fem
-    "rough_contact.scenes.hertz",         # from dolfinx import fem
-    "rough_contact.scenes.mindlin",       # from dolfinx import fem
-    "rough_contact.scenes.punch_bem",     # import ufl; from dolfinx import fem
-}
+# Modules that import dolfinx/ufl/basix directly although their layer must not: none (the
+# solver and the scenes ask the problem or rough_contact.fem.compat). A new entry needs a reason;
+# the test fails on an entry that no longer imports the FE stack.
+_PENDING_DOLFINX: set = set()
 
 # Import cycles (as sorted tuples of the modules of one strongly connected component) that
 # are known and not yet broken. Empty: the package has none; keep it so.
 _PENDING_CYCLES: set = set()
 
-# Imports of rough_contact.io from a layer below it that are known and not yet removed
-# (importer, imported module). solver.program takes loop_energies, a pure-numpy helper, from
-# io.plotting (a function-level import); it belongs in a pure module both can import.
-_PENDING_IO_USERS = {
-    ("rough_contact.solver.program", "rough_contact.io.plotting"),
-}
+# Imports of rough_contact.io from a layer below it (importer, imported module): none.
+_PENDING_IO_USERS: set = set()
 
 
 # --------------------------------------------------------------------------------------------
