@@ -7,9 +7,16 @@ Layers (each imports only those above it in this list):
     validation                        check_scalar, the one input check of every layer
     surface                           what a rough surface is: moments, spectra, height maps
     micro                             asperity, summit population, normal-law tables, BEM law
-    interface                         pure numpy interface laws at quadrature points
-    fem, solver                       DOLFINx / PETSc (the only packages importing them, with io)
+    interface                         pure numpy interface laws at quadrature points, the
+                                      enforcement strategies, the interface history
+    cycles, references                loop energies; closed forms the tests compare with
+    fem                               DOLFINx: pairings, jump operator, ContactInterface,
+                                      ContactProblem (the only package importing dolfinx,
+                                      with io and the gmsh mesh builders)
+    solver                            PETSc SNES, load stepping over the interface lifecycle,
+                                      checkpoints, load programs (petsc4py, no dolfinx)
     io                                results on disk (XDMF, CSV, atomic writes) and plots
+    scenes                            the paper's and the verification scenes (typed results)
 
 Internal unit system: mm, N, MPa (N/mm^2), so stiffnesses per area are in MPa/mm = N/mm^3.
 Spectral moments are given in the paper's micrometre convention at the API boundary
