@@ -325,7 +325,22 @@ def _read_model(model, split_body, surface_owners):
     def index(gmsh_nodes):
         return np.searchsorted(node_tags, gmsh_nodes)
 
-    # Cells and the body tag of each cell; volume entity -> body tag.
+    cells, cell_values, cell_type, body_of_volume = _read_cells(model, volumes, index)
+    facets, facet_values, facet_owner, n_facet_nodes = _read_facets(
+        model, volumes, surfaces, surface_owners, cell_type, body_of_volume, index)
+    x, cells, facets, n_shared = _split_body_nodes(x, cells, cell_values, facets, facet_owner,
+                                                   volumes[split_body][0])
+    x, cells, facets = _drop_unused_nodes(x, cells, facets, facet_values, surfaces)
+    labels = {name: int(tag) for name, (tag, _) in {**volumes, **surfaces}.items()}
+    bodies = (split_body,) + tuple(n for n in volumes if n != split_body)
+    return dict(x=x, cells=cells, cell_values=cell_values, facets=facets,
+                facet_values=facet_values, cell_type=int(cell_type), labels=labels, bodies=bodies,
+                n_shared=n_shared, n_facet_nodes=int(n_facet_nodes))
+
+
+def _read_cells(model, volumes, index):
+    """Cells (gmsh node order, indices into the sorted nodes), the body tag of each cell, the
+    gmsh cell type and the body tag of every volume entity."""
     cell_type, cell_blocks, cell_values, body_of_volume = None, [], [], {}
     for tag, entities in volumes.values():
         for entity in entities:
@@ -341,10 +356,12 @@ def _read_model(model, split_body, surface_owners):
             body_of_volume[entity] = tag
     if cell_type is None:
         raise ValueError("the gmsh model has no volume physical group with elements")
-    cells = np.concatenate(cell_blocks)
-    cell_values = np.concatenate(cell_values)
+    return np.concatenate(cell_blocks), np.concatenate(cell_values), cell_type, body_of_volume
 
-    # Facets, their tag and the body owning them.
+
+def _read_facets(model, volumes, surfaces, surface_owners, cell_type, body_of_volume, index):
+    """Facets of the surface groups, their tag and the body owning each (from
+    ``surface_owners`` or the one adjacent body); a facet of one body carries one tag."""
     owners_given = dict(surface_owners or {})
     facet_type = _GMSH_FACETS[cell_type]
     facet_blocks, facet_values, facet_owner = [], [], []
@@ -379,15 +396,17 @@ def _read_model(model, split_body, surface_owners):
               else np.empty((0, n_facet_nodes), dtype=np.int64))
     facet_values = np.concatenate(facet_values) if facet_values else np.empty(0, np.int32)
     facet_owner = np.concatenate(facet_owner) if facet_owner else np.empty(0, np.int32)
-
     # Facets of one body must not carry two tags (a MeshTags entity has one value).
     key = np.column_stack([np.sort(facets, axis=1), facet_owner])
     if len(np.unique(key, axis=0)) != len(key):
         raise ValueError("surface physical groups overlap: a facet of one body belongs to two "
                          "groups; make the groups disjoint")
+    return facets, facet_values, facet_owner, n_facet_nodes
 
-    # Duplicate the nodes the split body shares with the other bodies (vectorised).
-    split_tag = volumes[split_body][0]
+
+def _split_body_nodes(x, cells, cell_values, facets, facet_owner, split_tag):
+    """Duplicate the nodes the split body shares with the other bodies (vectorised): the
+    bodies become disconnected, their contact faces keep the same surface mesh."""
     split = cell_values == split_tag
     in_split = np.zeros(len(x), dtype=bool)
     in_split[cells[split].ravel()] = True
@@ -400,14 +419,7 @@ def _read_model(model, split_body, surface_owners):
     cells[split] = renumber[cells[split]]
     of_split = facet_owner == split_tag
     facets[of_split] = renumber[facets[of_split]]
-
-    x, cells, facets = _drop_unused_nodes(x, cells, facets, facet_values, surfaces)
-
-    labels = {name: int(tag) for name, (tag, _) in {**volumes, **surfaces}.items()}
-    bodies = (split_body,) + tuple(n for n in volumes if n != split_body)
-    return dict(x=x, cells=cells, cell_values=cell_values, facets=facets,
-                facet_values=facet_values, cell_type=int(cell_type), labels=labels, bodies=bodies,
-                n_shared=len(shared), n_facet_nodes=int(n_facet_nodes))
+    return x, cells, facets, len(shared)
 
 
 def _drop_unused_nodes(x, cells, facets, facet_values, surfaces):
