@@ -1,36 +1,59 @@
 """The one place where the DOLFINx API version shows.
 
-Everything in the package that needs a function space, the PETSc vector of a function, a
-mesh/tag from arrays, dofmap arrays or file output on a DOLFINx API that changed between
-releases calls the functions here. Supported: DOLFINx 0.5.2 (Debian 12) — and, once ported,
-0.9 (Debian 13). Nothing outside ``rough_contact.fem`` (and the mesh builders / output
-modules) imports dolfinx; the solver and the scenes ask the problem or these functions.
+Supported: DOLFINx 0.5.2 (Debian 12: numpy 1.24, PETSc 3.18, ufl 2022.2, basix 0.5) and 0.9
+(Debian 13: numpy 2.2, PETSc 3.22, ufl 2024.2, basix 0.9). Every call whose spelling differs
+between the two goes through a function here (function spaces with a value shape, the PETSc
+vector of a function, dofmap arrays, degrees, sparsity patterns, vector/matrix/null-space
+creation, the mesh domain, entity data and tags from gmsh arrays, lifting and Dirichlet rows,
+mesh tags in XDMF); calls that are the same on both are made directly. Nothing outside
+``rough_contact.fem`` (and the mesh builders / output modules) imports dolfinx; the solver and
+the scenes ask the problem or these functions. docs/dolfinx09_port.md lists every call and
+its two spellings, each checked on both versions.
 
 Units: none (pure plumbing).
 """
 
 from __future__ import annotations
 
+from typing import Sequence
+
 import numpy as np
 
 import dolfinx
 import dolfinx.fem
+import dolfinx.fem.petsc
+import dolfinx.la
+import dolfinx.mesh
 
-__all__ = ["DOLFINX_VERSION", "vector_space", "petsc_vector", "function_values", "element_degree",
-           "geometry_degree", "geometry_dofmap", "cell_dofmap", "create_petsc_vector",
-           "form_sparsity", "block_csr_matrix"]
+__all__ = ["DOLFINX_VERSION", "NEW_API", "vector_space", "petsc_vector", "function_values",
+           "element_degree", "geometry_degree", "geometry_dofmap", "cell_dofmap",
+           "create_petsc_vector", "form_sparsity", "block_csr_matrix", "near_nullspace",
+           "mesh_domain", "create_mesh", "meshtags_from_arrays", "facet_geometry_nodes",
+           "set_bc", "apply_lifting", "write_meshtags", "DirichletBC"]
 
 DOLFINX_VERSION: tuple = tuple(int(p) for p in dolfinx.__version__.split(".")[:2])
+#: True on DOLFINx >= 0.8 (the API of 0.9); False on 0.5.2.
+NEW_API: bool = DOLFINX_VERSION >= (0, 8)
+if DOLFINX_VERSION < (0, 5) or (0, 5) < DOLFINX_VERSION < (0, 8) or DOLFINX_VERSION > (0, 9):
+    import warnings
+    warnings.warn(f"DOLFINx {dolfinx.__version__} is not a tested version (0.5.2 and 0.9 are); "
+                  "rough_contact may fail", RuntimeWarning, stacklevel=2)
+
+#: The Dirichlet condition type (for annotations and isinstance).
+DirichletBC = dolfinx.fem.DirichletBC if NEW_API else dolfinx.fem.DirichletBCMetaClass
 
 
+# ------------------------------------------------------------------ spaces and functions
 def vector_space(mesh, degree: int, family: str = "Lagrange"):
     """The vector (3-component) space of ``family`` and ``degree`` on ``mesh``."""
+    if NEW_API:
+        return dolfinx.fem.functionspace(mesh, (family, int(degree), (3,)))
     return dolfinx.fem.VectorFunctionSpace(mesh, (family, int(degree)))
 
 
 def petsc_vector(u):
     """The PETSc vector holding the owned (and ghost) values of the Function ``u``."""
-    return u.vector
+    return u.x.petsc_vec if NEW_API else u.vector
 
 
 def function_values(u) -> np.ndarray:
@@ -40,7 +63,7 @@ def function_values(u) -> np.ndarray:
 
 def element_degree(V) -> int:
     """Polynomial degree of the space ``V``."""
-    return int(V.ufl_element().degree())
+    return int(V.element.basix_element.degree)
 
 
 def geometry_degree(mesh) -> int:
@@ -51,35 +74,42 @@ def geometry_degree(mesh) -> int:
 def geometry_dofmap(mesh) -> np.ndarray:
     """(n_cells, n_geometry_nodes) geometry node indices of every local cell."""
     dm = mesh.geometry.dofmap
-    return dm.array.reshape(dm.num_nodes, -1)
+    return np.asarray(dm) if NEW_API else dm.array.reshape(dm.num_nodes, -1)
 
 
 def cell_dofmap(V) -> np.ndarray:
     """(n_cells, n_dofs_per_cell) block (node) indices of every local cell of ``V``."""
     dm = V.dofmap.list
-    return dm.array.reshape(dm.num_nodes, -1)
+    return np.asarray(dm) if NEW_API else dm.array.reshape(dm.num_nodes, -1)
 
 
+# ------------------------------------------------------------------ PETSc objects
 def create_petsc_vector(V):
     """A new (ghosted) PETSc vector of ``V``'s layout, block size of ``V``."""
+    imap, bs = V.dofmap.index_map, V.dofmap.index_map_bs
+    if NEW_API:
+        return dolfinx.la.create_petsc_vector(imap, bs)
     import dolfinx.cpp
-    return dolfinx.cpp.la.petsc.create_vector(V.dofmap.index_map, V.dofmap.index_map_bs)
+    return dolfinx.cpp.la.petsc.create_vector(imap, bs)
 
 
 def form_sparsity(a, V) -> tuple[np.ndarray, np.ndarray]:
     """The node-level (block) sparsity pattern of the bilinear form ``a`` on ``V`` x ``V`` on
     this rank's owned rows, in global indices: (rows, cols) int64 arrays."""
     sp = dolfinx.fem.create_sparsity_pattern(a)
-    sp.assemble()
+    if NEW_API:
+        sp.finalize()
+        array, offsets = sp.graph
+    else:
+        sp.assemble()
+        array, offsets = sp.graph.array, sp.graph.offsets
     imap = V.dofmap.index_map
     n_loc, r0 = imap.size_local, imap.local_range[0]
-    graph = sp.graph
     cm = sp.column_index_map()
     col_l2g = np.concatenate(
-        [np.arange(*cm.local_range, dtype=np.int64), cm.ghosts.astype(np.int64)])
-    off = graph.offsets
-    rows = np.repeat(np.arange(n_loc, dtype=np.int64) + r0, np.diff(off[: n_loc + 1]))
-    cols = col_l2g[graph.array[: off[n_loc]]]
+        [np.arange(*cm.local_range, dtype=np.int64), np.asarray(cm.ghosts, dtype=np.int64)])
+    rows = np.repeat(np.arange(n_loc, dtype=np.int64) + r0, np.diff(offsets[: n_loc + 1]))
+    cols = col_l2g[np.asarray(array[: offsets[n_loc]])]
     return rows, cols
 
 
@@ -106,9 +136,102 @@ def block_csr_matrix(V, local_rows: np.ndarray, global_cols: np.ndarray):
     A.setType(PETSc.Mat.Type.AIJ)
     A.setPreallocationCSR((indptr.astype(PETSc.IntType), indices.astype(PETSc.IntType)))
     l2g = np.concatenate(
-        [np.arange(*imap.local_range, dtype=np.int64), imap.ghosts.astype(np.int64)])
+        [np.arange(*imap.local_range, dtype=np.int64), np.asarray(imap.ghosts, dtype=np.int64)])
     lgmap = PETSc.LGMap().create(l2g.astype(PETSc.IntType), bsize=bs, comm=MPI.COMM_SELF)
     A.setLGMap(lgmap, lgmap)
     A.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, True)
     A.zeroEntries()
     return A
+
+
+def near_nullspace(V, n_vectors: int, fill):
+    """An orthonormalised PETSc near-nullspace of ``n_vectors`` vectors of ``V``'s layout;
+    ``fill(k, local_array)`` writes vector k's local values (owned and ghost)."""
+    from petsc4py import PETSc
+    imap, bs = V.dofmap.index_map, V.dofmap.index_map_bs
+    if NEW_API:
+        vecs = [dolfinx.la.vector(imap, bs) for _ in range(n_vectors)]
+        for k, v in enumerate(vecs):
+            fill(k, v.array)
+        dolfinx.la.orthonormalize(vecs)
+        n_own = bs * imap.size_local
+        petsc = [PETSc.Vec().createWithArray(v.array[:n_own].copy(), bsize=bs,
+                                             comm=V.mesh.comm) for v in vecs]
+        return PETSc.NullSpace().create(vectors=petsc, comm=V.mesh.comm)
+    vecs = [dolfinx.la.create_petsc_vector(imap, bs) for _ in range(n_vectors)]
+    for k, v in enumerate(vecs):
+        with v.localForm() as loc:
+            fill(k, np.asarray(loc))
+    dolfinx.la.orthonormalize(vecs)
+    return PETSc.NullSpace().create(vectors=vecs, comm=V.mesh.comm)
+
+
+# ------------------------------------------------------------------ meshes and tags
+def mesh_domain(cell_name: str, degree: int):
+    """The ufl domain of a 3D mesh of ``cell_name`` cells ("tetrahedron", "hexahedron") with
+    an equispaced Lagrange geometry of ``degree``."""
+    import ufl
+    if NEW_API:
+        import basix
+        import basix.ufl
+        return ufl.Mesh(basix.ufl.element("Lagrange", cell_name, int(degree), shape=(3,),
+                                          lagrange_variant=basix.LagrangeVariant.equispaced))
+    cell = ufl.Cell(cell_name, geometric_dimension=3)
+    return ufl.Mesh(ufl.VectorElement(
+        ufl.FiniteElement("Lagrange", cell, int(degree), variant="equispaced")))
+
+
+def create_mesh(comm, cells: np.ndarray, x: np.ndarray, cell_name: str, degree: int):
+    """A distributed mesh from rank-0 arrays (cells in DOLFINx node order, int64)."""
+    return dolfinx.mesh.create_mesh(comm, np.asarray(cells, dtype=np.int64), x,
+                                    mesh_domain(cell_name, degree))
+
+
+def meshtags_from_arrays(msh, dim: int, entities: np.ndarray, values: np.ndarray):
+    """MeshTags of dimension ``dim`` from rank-0 entity arrays (vertices in DOLFINx order,
+    original input node numbers) and their values (collective)."""
+    if NEW_API:
+        import dolfinx.graph
+        import dolfinx.io
+        ents, vals = dolfinx.io.distribute_entity_data(msh, dim, entities,
+                                                       np.asarray(values, dtype=np.int32))
+        adjacency = dolfinx.graph.adjacencylist(ents)
+    else:
+        import dolfinx.cpp
+        ents, vals = dolfinx.cpp.io.distribute_entity_data(msh._mesh, dim, entities, values)
+        adjacency = dolfinx.cpp.graph.AdjacencyList_int32(ents)
+    return dolfinx.mesh.meshtags_from_entities(msh, dim, adjacency, np.asarray(vals, np.int32))
+
+
+def facet_geometry_nodes(msh, facets: np.ndarray) -> np.ndarray:
+    """(n, n_nodes) geometry node indices of the given local facets."""
+    fdim = msh.topology.dim - 1
+    if NEW_API:
+        return dolfinx.mesh.entities_to_geometry(msh, fdim, np.asarray(facets, np.int32), False)
+    import dolfinx.cpp
+    return dolfinx.cpp.mesh.entities_to_geometry(msh._mesh, fdim, facets, False)
+
+
+def write_meshtags(xdmf, tags, msh) -> None:
+    """Write MeshTags to an open XDMFFile."""
+    if NEW_API:
+        xdmf.write_meshtags(tags, msh.geometry)
+    else:
+        xdmf.write_meshtags(tags)
+
+
+# ------------------------------------------------------------------ Dirichlet rows, lifting
+def set_bc(b, bcs: Sequence, x0=None, scale: float = 1.0) -> None:
+    """Dirichlet rows of the PETSc vector b: b = scale (g - x0) (x0 None: scale g)."""
+    if NEW_API:
+        dolfinx.fem.petsc.set_bc(b, bcs, x0, alpha=scale)
+    else:
+        dolfinx.fem.petsc.set_bc(b, bcs, x0, scale=scale)
+
+
+def apply_lifting(b, a: Sequence, bcs: Sequence, scale: float = 1.0) -> None:
+    """b -= scale A g for the Dirichlet values g (dolfinx's lifting), per form of ``a``."""
+    if NEW_API:
+        dolfinx.fem.petsc.apply_lifting(b, a, bcs=bcs, alpha=scale)
+    else:
+        dolfinx.fem.petsc.apply_lifting(b, a, bcs=bcs, scale=scale)

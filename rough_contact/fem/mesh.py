@@ -36,6 +36,8 @@ import dolfinx.fem
 import dolfinx.mesh
 import ufl
 
+from rough_contact.fem import compat
+
 __all__ = [
     "Scene",
     "ConformityReport",
@@ -602,7 +604,7 @@ def _read_xdmf_part(path: str, labels: dict, mesh_name: str, cell_tags: str,
     n_nodes = {4: 4, 11: 10, 5: 8, 12: 27}[gmsh_cell]
     dolfinx_cell = dolfinx.cpp.mesh.to_type(name)
     x = np.array(msh.geometry.x, dtype=np.float64)
-    dofmap = np.asarray(msh.geometry.dofmap.array, dtype=np.int64).reshape(-1, n_nodes)
+    dofmap = np.asarray(compat.geometry_dofmap(msh), dtype=np.int64).reshape(-1, n_nodes)
     cells = np.empty_like(dofmap)
     cells[:, dolfinx.cpp.io.perm_gmsh(dolfinx_cell, n_nodes)] = dofmap   # back to gmsh order
     n_cells = len(cells)
@@ -711,28 +713,20 @@ def _scene_from_data(data, comm, *, contact_pair, rigid_plane, rank, dimensions)
     if contact_pair[1] is None and rigid_plane is None:
         raise ValueError("contact_pair has no second surface: give rigid_plane=(point, normal)")
 
-    cell = ufl.Cell(name, geometric_dimension=3)
-    domain = ufl.Mesh(ufl.VectorElement(
-        ufl.FiniteElement("Lagrange", cell, degree, variant="equispaced")))
     dolfinx_cell = dolfinx.cpp.mesh.to_type(name)
     cells = cells[:, dolfinx.cpp.io.perm_gmsh(dolfinx_cell, n_nodes)]
-    msh = dolfinx.mesh.create_mesh(comm, cells, x, domain)
+    msh = compat.create_mesh(comm, cells, x, name, degree)
     tdim = msh.topology.dim
 
-    entities, values = dolfinx.cpp.io.distribute_entity_data(msh._mesh, tdim, cells, cell_values)
     msh.topology.create_connectivity(tdim, 0)
-    cell_tags = dolfinx.mesh.meshtags_from_entities(
-        msh, tdim, dolfinx.cpp.graph.AdjacencyList_int32(entities), values.astype(np.int32))
+    cell_tags = compat.meshtags_from_arrays(msh, tdim, cells, cell_values)
     cell_tags.name = "cell_tags"
 
     facet_cell = dolfinx.cpp.mesh.cell_entity_type(dolfinx_cell, tdim - 1, 0)
     facets = facets[:, dolfinx.cpp.io.perm_gmsh(facet_cell, facets.shape[1])]
-    entities, values = dolfinx.cpp.io.distribute_entity_data(msh._mesh, tdim - 1, facets,
-                                                             facet_values)
     msh.topology.create_connectivity(tdim - 1, tdim)
     msh.topology.create_connectivity(tdim - 1, 0)
-    facet_tags = dolfinx.mesh.meshtags_from_entities(
-        msh, tdim - 1, dolfinx.cpp.graph.AdjacencyList_int32(entities), values.astype(np.int32))
+    facet_tags = compat.meshtags_from_arrays(msh, tdim - 1, facets, facet_values)
     facet_tags.name = "facet_tags"
 
     pair = (labels[contact_pair[0]],
@@ -765,7 +759,7 @@ def facet_vertex_coordinates(scene: Scene, tag: int) -> np.ndarray:
         return np.empty((0, n_corners, 3))
     msh.topology.create_connectivity(fdim, 0)
     # Corner geometry nodes (the first n_corners nodes of a P1/P2 facet are its vertices).
-    nodes = dolfinx.cpp.mesh.entities_to_geometry(msh._mesh, fdim, facets, False)
+    nodes = compat.facet_geometry_nodes(msh, facets)
     return msh.geometry.x[nodes[:, :n_corners]]
 
 
@@ -852,8 +846,8 @@ def write_xdmf(scene: Scene, filename: str) -> None:
     msh.topology.create_connectivity(msh.topology.dim - 1, msh.topology.dim)
     with XDMFFile(msh.comm, filename, "w") as xdmf:
         xdmf.write_mesh(msh)
-        xdmf.write_meshtags(scene.cell_tags)
-        xdmf.write_meshtags(scene.facet_tags)
+        compat.write_meshtags(xdmf, scene.cell_tags, msh)
+        compat.write_meshtags(xdmf, scene.facet_tags, msh)
 
 
 def describe(scene: Scene) -> str:

@@ -25,13 +25,12 @@ without any error.
 
 from __future__ import annotations
 
-import contextlib
 from dataclasses import dataclass
 from typing import Optional, Sequence
 
 import numpy as np
 import ufl
-from dolfinx import fem, la
+from dolfinx import fem
 from dolfinx.fem import petsc as fem_petsc
 from mpi4py import MPI
 from petsc4py import PETSc
@@ -155,29 +154,28 @@ def rigid_body_modes(V: fem.FunctionSpace,
     imap, bs = V.dofmap.index_map, V.dofmap.index_map_bs
     x = V.tabulate_dof_coordinates()
     n_local = imap.size_local + imap.num_ghosts
-    groups = list(cell_groups) or [None]
-    vecs = []
-    for cells in groups:
-        if cells is None:
-            blocks = np.arange(n_local, dtype=np.int32)
+    groups = [np.arange(n_local, dtype=np.int32) if cells is None
+              else np.unique(compat.cell_dofmap(V)[cells])
+              for cells in (list(cell_groups) or [None])]
+
+    def fill(k: int, basis: np.ndarray) -> None:
+        blocks = groups[k // 6]
+        x0, x1, x2 = x[blocks, 0], x[blocks, 1], x[blocks, 2]
+        mode = k % 6
+        if mode < 3:
+            basis[bs * blocks + mode] = 1.0
+        elif mode == 3:
+            basis[bs * blocks + 0] = -x1
+            basis[bs * blocks + 1] = x0
+        elif mode == 4:
+            basis[bs * blocks + 0] = x2
+            basis[bs * blocks + 2] = -x0
         else:
-            blocks = np.unique(V.dofmap.list.array.reshape(-1, V.dofmap.dof_layout.num_dofs)[cells])
-        group_vecs = [la.create_petsc_vector(imap, bs) for _ in range(6)]
-        with contextlib.ExitStack() as stack:
-            basis = [np.asarray(stack.enter_context(v.localForm())) for v in group_vecs]
-            x0, x1, x2 = x[blocks, 0], x[blocks, 1], x[blocks, 2]
-            for i in range(3):
-                basis[i][bs * blocks + i] = 1.0
-            basis[3][bs * blocks + 0] = -x1
-            basis[3][bs * blocks + 1] = x0
-            basis[4][bs * blocks + 0] = x2
-            basis[4][bs * blocks + 2] = -x0
-            basis[5][bs * blocks + 2] = x1
-            basis[5][bs * blocks + 1] = -x2
-        vecs.extend(group_vecs)
+            basis[bs * blocks + 2] = x1
+            basis[bs * blocks + 1] = -x2
+
     # A rank may own no DOF of a body: its vectors are then zero locally, which is fine globally.
-    la.orthonormalize(vecs)
-    return PETSc.NullSpace().create(vectors=vecs, comm=V.mesh.comm)
+    return compat.near_nullspace(V, 6 * len(groups), fill)
 
 
 class ContactProblem:
@@ -217,7 +215,7 @@ class ContactProblem:
         self,
         V: fem.FunctionSpace,
         materials,
-        bcs: Sequence[fem.DirichletBCMetaClass] = (),
+        bcs: Sequence[compat.DirichletBC] = (),
         loads: Sequence[SurfaceLoad] = (),
         cell_tags=None,
         facet_tags=None,
@@ -354,9 +352,9 @@ class ContactProblem:
             full = fem_petsc.assemble_vector(fem.form(form))
             full.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
             free = full.copy()
-            fem_petsc.set_bc(free, self.bcs, scale=0.0)
+            compat.set_bc(free, self.bcs, scale=0.0)
             self._f_channel[name] = (free, full)
-        fem_petsc.set_bc(self.f, self.bcs, scale=0.0)
+        compat.set_bc(self.f, self.bcs, scale=0.0)
         self.lift = self.f.duplicate()
         self.update_dirichlet()
         self.f_norm = self.f.norm()
@@ -423,7 +421,7 @@ class ContactProblem:
             self.interface.evaluate(self.u)
             self.interface.assemble_residual(b)
         t2 = MPI.Wtime()
-        fem_petsc.set_bc(b, self.bcs, x, -1.0)
+        compat.set_bc(b, self.bcs, x, -1.0)
         self.timings["bulk"] += t1 - t0
         self.timings["interface_residual"] += t2 - t1
         self.counters["residual"] += 1
@@ -509,9 +507,9 @@ class ContactProblem:
         """
         with self.lift.localForm() as loc:
             loc.set(0.0)
-        fem_petsc.apply_lifting(self.lift, [self.a], bcs=[self.bcs], scale=-1.0)
+        compat.apply_lifting(self.lift, [self.a], [self.bcs], scale=-1.0)
         self.lift.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-        fem_petsc.set_bc(self.lift, self.bcs, scale=0.0)
+        compat.set_bc(self.lift, self.bcs, scale=0.0)
 
     def _prescribed_bcs(self, prescribed, facet_tags):
         """(g, bc, g at lam = 1, tag, component) per prescribed component; g lives on the
