@@ -8,6 +8,7 @@ Prints set-up, matrix-creation and per-call residual / Jacobian times of Contact
 """
 
 from __future__ import annotations
+from rough_contact.fem import compat
 
 import argparse
 import time
@@ -34,7 +35,7 @@ def main(argv=None):
 
     comm = MPI.COMM_WORLD
     sc = flat_punch(mesh_size=args.mesh_size, contact_size=args.contact_size, order=args.order)
-    V = fem.VectorFunctionSpace(sc.mesh, ("Lagrange", args.order))
+    V = compat.vector_space(sc.mesh, args.order)
     law = SoftplusPenalty(1e4, 1e-3, k_tangential=5e3, friction=0.3)
 
     def tmax(t0):
@@ -60,7 +61,7 @@ def main(argv=None):
     rng = np.random.default_rng(comm.rank)
     u.x.array[:] = rng.uniform(-1e-3, 1e-3, u.x.array.size)
     u.x.scatter_forward()
-    b = u.vector.duplicate()
+    b = compat.petsc_vector(u).duplicate()
     t_res, t_jac, t_kernel = [], [], []
     for i in range(args.repeat):
         u.x.array[:] *= 1.0 + 1e-3  # a new iterate each time (no cached evaluation)

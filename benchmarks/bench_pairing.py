@@ -42,6 +42,7 @@ from petsc4py import PETSc
 import dolfinx
 import dolfinx.fem.petsc
 from dolfinx import fem
+from rough_contact.fem import compat
 from rough_contact.fem.contact import ContactInterface
 from rough_contact.fem.problem import ContactProblem, Material, SurfaceLoad
 from rough_contact.interface.penalty import LinearPenalty, SoftplusPenalty
@@ -59,7 +60,7 @@ def _roller(V, scene, name, comp):
 def patch_error(cell_type, order, size_lower, size_upper, first, pairing, degree):
     scene = separate_blocks(h1=1.0, h2=0.5, size_lower=size_lower, size_upper=size_upper,
                             order=order, cell_type=cell_type)
-    V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", order))
+    V = compat.vector_space(scene.mesh, order)
     bcs = [_roller(V, scene, "x0", 0), _roller(V, scene, "y0", 1),
            _roller(V, scene, "bottom", 2)]
     a, b = scene.contact_pair if first == "upper" else scene.contact_pair[::-1]
@@ -109,7 +110,7 @@ def cost(points, only=None):
         for label, n_up in (("equal", n_side), ("5:7", int(round(n_side * 7 / 5)))):
             scene = separate_blocks(h1=1.0 / n_side, h2=1.0 / n_side, size_lower=1.0 / n_side,
                                     size_upper=1.0 / n_up, cell_type="hexahedron")
-            V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", 1))
+            V = compat.vector_space(scene.mesh, 1)
             u = fem.Function(V)
             u.interpolate(lambda x: 1e-4 * np.stack([np.sin(x[0]), np.cos(x[1]), x[2] - 0.5]))
             du, v = ufl.TrialFunction(V), ufl.TestFunction(V)
@@ -127,7 +128,7 @@ def cost(points, only=None):
                                       sliding="moderate" if pairing == "moderate" else "small")
                 t_setup = time.perf_counter() - t0
                 A = ci.create_matrix(a)
-                b = dolfinx.cpp.la.petsc.create_vector(V.dofmap.index_map, 3)
+                b = compat.create_petsc_vector(V)
                 t0 = time.perf_counter()
                 A.zeroEntries()
                 dolfinx.fem.petsc.assemble_matrix(A, a)
@@ -174,7 +175,7 @@ def newton(points, only=None):
                             if only is None or p in only]:
                 scene = separate_blocks(h1=0.25, h2=0.25, size_lower=1.0 / n_side,
                                         size_upper=1.0 / n_up, cell_type="hexahedron")
-                V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", 1))
+                V = compat.vector_space(scene.mesh, 1)
                 bcs = [_roller(V, scene, "x0", 0), _roller(V, scene, "y0", 1),
                        _roller(V, scene, "bottom", 2)]
                 law = SoftplusPenalty(1e6, 1e-6, k_tangential=1e6, friction=0.3)

@@ -36,6 +36,7 @@ Units: mm, N, MPa.
 """
 
 from __future__ import annotations
+from rough_contact.fem import compat
 
 import sys
 
@@ -298,7 +299,7 @@ def _patch(comm, cell_type, order, size_lower, size_upper, first, law_name, e_ra
         SoftplusPenalty(1e6, 1e-7, k_tangential=1e6, friction=0.3)
     scene = separate_blocks(h1=1.0, h2=0.5, size_lower=size_lower, size_upper=size_upper,
                             order=order, cell_type=cell_type, comm=comm)
-    V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", order))
+    V = compat.vector_space(scene.mesh, order)
 
     def roller(name, comp):
         dofs = fem.locate_dofs_topological(V.sub(comp), 2, scene.facet_tags.find(scene.tag(name)))

@@ -15,6 +15,7 @@ from petsc4py import PETSc
 
 from dolfinx import fem
 
+from rough_contact.fem import compat
 from rough_contact.fem.contact import ContactInterface
 from rough_contact.fem.problem import ContactProblem, Material, SurfaceLoad
 from rough_contact.interface.enforcement import AugmentedLagrangian, Penalty
@@ -30,7 +31,7 @@ P, Q, MU = 1.0, 0.05, 1.0           # pressure and shear on the top [MPa], frict
 
 def _block(order):
     scene = block_on_plane(lx=1.0, ly=1.0, h=H, mesh_size=0.25, order=order)
-    V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", order))
+    V = compat.vector_space(scene.mesh, order)
     return scene, V
 
 
@@ -56,7 +57,7 @@ def _clamped(scene, V):
 def _on_plane(scene, V, augmented, k, **kwargs):
     law = SoftplusPenalty(k_normal=k, width=1e-6 * P / k, k_tangential=k, friction=MU)
     enforcement = AugmentedLagrangian(**kwargs) if augmented else Penalty()
-    order = V.ufl_element().degree()
+    order = compat.element_degree(V)
     if order == 1:
         ci = ContactInterface(V, scene.facet_tags, scene.tag("contact"), law=law,
                               rigid_plane=scene.rigid_plane, quadrature="vertex",

@@ -19,6 +19,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from dolfinx import fem
+from rough_contact.fem import compat
 from rough_contact.fem.contact import ContactInterface
 from rough_contact.fem.problem import (ContactProblem, Material, PrescribedDisplacement,
                                        SurfaceLoad)
@@ -46,7 +47,7 @@ def _model(mesh_size=0.5):
         _SCENES[mesh_size] = two_blocks(lx=2.0, ly=2.0, h1=1.0, h2=1.0, mesh_size=mesh_size,
                                         order=1)
     scene = _SCENES[mesh_size]
-    V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", 1))
+    V = compat.vector_space(scene.mesh, 1)
     clamp = fem.dirichletbc(np.zeros(3, dtype=PETSc.ScalarType), fem.locate_dofs_topological(
         V, 2, scene.facet_tags.find(scene.tag("bottom"))), V)
     law, normal = flat_punch.make_law(comm, case="b", normal_law="elastic", seating_pressure=5.0,

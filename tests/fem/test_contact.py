@@ -17,6 +17,7 @@ import dolfinx
 import dolfinx.fem.petsc
 from dolfinx import fem
 from dolfinx import mesh as dmesh
+from rough_contact.fem import compat
 from rough_contact.fem.contact import ContactInterface
 from rough_contact.interface.contract import ConvergenceError
 from rough_contact.interface.penalty import LinearPenalty, SoftplusPenalty
@@ -115,11 +116,11 @@ def smooth_field(x, up=0.0, scale=1e-3):
 
 
 def vec_copy(V, u):
-    return u.vector.copy()
+    return compat.petsc_vector(u).copy()
 
 
 def residual(ci, V, x):
-    b = dolfinx.cpp.la.petsc.create_vector(V.dofmap.index_map, V.dofmap.index_map_bs)
+    b = compat.create_petsc_vector(V)
     b.set(0.0)
     ci.evaluate(x)
     ci.assemble_residual(b)
@@ -131,7 +132,7 @@ def test_against_ufl_linear_penalty_rigid(degree):
     """(a) Frictionless linear penalty against a rigid plane == k (u.n)(v.n) ds in UFL."""
     comm = MPI.COMM_WORLD
     msh, tags = two_blocks(comm, n=(3, 2, 2), single=True)
-    V = fem.VectorFunctionSpace(msh, ("Lagrange", degree))
+    V = compat.vector_space(msh, degree)
     k = 1.7e3
     ci = ContactInterface(V, tags, LOWER_TOP, law=LinearPenalty(k), quadrature_degree=2 * degree)
     u = fem.Function(V)
@@ -165,7 +166,7 @@ def test_create_matrix_holds_bulk_and_interface():
     """The merged pattern takes dolfinx's own bulk assembly (bcs included) unchanged."""
     comm = MPI.COMM_WORLD
     msh, tags = two_blocks(comm, n=(2, 2, 2))
-    V = fem.VectorFunctionSpace(msh, ("Lagrange", 2))
+    V = compat.vector_space(msh, 2)
     du, v = ufl.TrialFunction(V), ufl.TestFunction(V)
     a = fem.form(ufl.inner(ufl.grad(du), ufl.grad(v)) * ufl.dx)
     dofs = fem.locate_dofs_topological(V, 2, tags.indices[tags.values == LOWER_BOTTOM])
@@ -220,7 +221,7 @@ def test_jacobian_finite_difference_two_blocks(degree, regime):
     """(b) The interface Jacobian equals a central FD of the interface residual."""
     comm = MPI.COMM_WORLD
     msh, tags = two_blocks(comm, n=(2, 3, 1))
-    V = fem.VectorFunctionSpace(msh, ("Lagrange", degree))
+    V = compat.vector_space(msh, degree)
     if regime == "penalty":
         law = LinearPenalty(2e3, k_tangential=7e2)
         scale = 1e-3
@@ -247,7 +248,7 @@ def test_uniform_jump_patch():
     comm = MPI.COMM_WORLD
     Lx, Ly = 1.3, 0.7
     msh, tags = two_blocks(comm, n=(3, 2, 1), size=(Lx, Ly, 0.4))
-    V = fem.VectorFunctionSpace(msh, ("Lagrange", 2))
+    V = compat.vector_space(msh, 2)
     kn, kt = 3e3, 1e3
     ci = ContactInterface(V, tags, LOWER_TOP, UPPER_BOTTOM, law=LinearPenalty(kn, kt))
     d = np.array([2e-3, -1e-3, -5e-4])  # upper body moves by d, lower stays
@@ -294,7 +295,7 @@ def _global_figures(comm, degree, patch):
             np.isin(tags.values, [LOWER_TOP, UPPER_BOTTOM]) & ~small, 99, tags.values
         ).astype(np.int32)
         tags = dmesh.meshtags(msh, 2, tags.indices, vals)
-    V = fem.VectorFunctionSpace(msh, ("Lagrange", degree))
+    V = compat.vector_space(msh, degree)
     law = SoftplusPenalty(1e4, 1e-3, k_tangential=5e3, friction=0.3)
     ci = ContactInterface(V, tags, LOWER_TOP, UPPER_BOTTOM, law=law)
     u = fem.Function(V)
@@ -329,7 +330,7 @@ def test_rank_independent_and_empty_ranks(degree, patch):
 def test_errors():
     comm = MPI.COMM_WORLD
     msh, tags = two_blocks(comm, n=(2, 2, 1))
-    V = fem.VectorFunctionSpace(msh, ("Lagrange", 1))
+    V = compat.vector_space(msh, 1)
     law = LinearPenalty(1.0)
     with pytest.raises(ValueError, match="tag 42"):
         ContactInterface(V, tags, 42, UPPER_BOTTOM, law=law)
@@ -395,12 +396,12 @@ def test_jacobian_finite_difference_rough_law(degree, regime):
     )
     comm = MPI.COMM_WORLD
     msh, tags = two_blocks(comm, n=(2, 2, 1))
-    V = fem.VectorFunctionSpace(msh, ("Lagrange", degree))
+    V = compat.vector_space(msh, degree)
     ci = ContactInterface(V, tags, LOWER_TOP, UPPER_BOTTOM, law=law, grain_direction=(1, 0.5, 0))
     scale = 1e-7 if regime == "stick" else 3e-3
     u = fem.Function(V)
     interpolate_bodies(u, lambda x, up: smooth_field(x, up, scale))
-    x = u.vector.copy()
+    x = compat.petsc_vector(u).copy()
     res = ci.evaluate(x)
     frac = comm.allreduce(int(res.slipping.sum())) / ci.n_points_global
     print("slipping fraction", frac)
@@ -421,7 +422,7 @@ def test_uniform_jump_patch_gmsh_scene(cell_type, order):
     lx, ly = 1.0, 0.8
     sc = blocks.two_blocks(lx=lx, ly=ly, h1=0.4, h2=0.4, mesh_size=0.35, order=order,
                            cell_type=cell_type)
-    V = fem.VectorFunctionSpace(sc.mesh, ("Lagrange", order))
+    V = compat.vector_space(sc.mesh, order)
     kn, kt = 3e3, 1e3
     first, second = sc.contact_pair  # first = upper block bottom: n = -z
     ci = ContactInterface(V, sc.facet_tags, first, second, law=LinearPenalty(kn, kt),
@@ -443,7 +444,7 @@ def test_against_ufl_gmsh_block_on_plane(cell_type, order):
     UFL."""
     sc = blocks.block_on_plane(lx=1.0, ly=0.7, h=0.5, mesh_size=0.3, order=order,
                                cell_type=cell_type)
-    V = fem.VectorFunctionSpace(sc.mesh, ("Lagrange", order))
+    V = compat.vector_space(sc.mesh, order)
     k = 2.3e3
     first, _ = sc.contact_pair
     ci = ContactInterface(V, sc.facet_tags, first, None, law=LinearPenalty(k),
@@ -473,7 +474,7 @@ def test_against_ufl_gmsh_block_on_plane(cell_type, order):
 
 def _partner_figures(c, split, degree, pairing):
     msh, tags = two_blocks(c, n=(3, 2, 1), split=split)
-    V = fem.VectorFunctionSpace(msh, ("Lagrange", degree))
+    V = compat.vector_space(msh, degree)
     law = SoftplusPenalty(1e4, 1e-3, k_tangential=5e3, friction=0.2)
     ci = ContactInterface(V, tags, LOWER_TOP, UPPER_BOTTOM, law=law, pairing=pairing)
     assert ci.pairing_used == pairing
@@ -490,7 +491,7 @@ def _partner_figures(c, split, degree, pairing):
     A.assemble()
     figs = np.concatenate([ci.contact_force(), [b.norm(), A.norm(), ci.real_contact_area()]])
     if split:
-        assert fd_check(ci, V, u.vector.copy(), 1e-8, np.random.default_rng(9)) < 1e-6
+        assert fd_check(ci, V, compat.petsc_vector(u).copy(), 1e-8, np.random.default_rng(9)) < 1e-6
     return figs
 
 
@@ -512,7 +513,7 @@ def test_history_commit_revert_and_dissipation():
     """commit() accumulates the dissipation and the plastic slip; revert() discards a trial."""
     comm = MPI.COMM_WORLD
     msh, tags = two_blocks(comm, n=(2, 2, 1))
-    V = fem.VectorFunctionSpace(msh, ("Lagrange", 1))
+    V = compat.vector_space(msh, 1)
     mu = 0.05
     law = SoftplusPenalty(1e4, 1e-3, k_tangential=5e3, friction=mu)
     ci = ContactInterface(V, tags, LOWER_TOP, UPPER_BOTTOM, law=law)
@@ -549,7 +550,7 @@ def test_dirichlet_dofs_are_skipped(degree):
     """Interface rows and columns of Dirichlet DOFs stay empty (bcs through the interface)."""
     comm = MPI.COMM_WORLD
     msh, tags = two_blocks(comm, n=(3, 2, 1))
-    V = fem.VectorFunctionSpace(msh, ("Lagrange", degree))
+    V = compat.vector_space(msh, degree)
     # x = 0 side of both blocks, u_x only (a symmetry condition through the interface edge)
     fdim = 2
     side = dmesh.locate_entities_boundary(msh, fdim, lambda x: np.isclose(x[0], 0.0))

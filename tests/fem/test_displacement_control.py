@@ -18,6 +18,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from dolfinx import fem, mesh as dmesh
+from rough_contact.fem import compat
 from rough_contact.fem.problem import (ContactProblem, Material, PrescribedDisplacement,
                                        SurfaceLoad)
 from rough_contact.solver.loading import load_path
@@ -39,7 +40,7 @@ def _block(order=2):
     vals[np.isclose(mid[:, 2], 1.0)] = TOP
     keep = vals > 0
     tags = dmesh.meshtags(msh, 2, facets[keep], vals[keep])
-    V = fem.VectorFunctionSpace(msh, ("Lagrange", order))
+    V = compat.vector_space(msh, order)
     clamp = fem.dirichletbc(np.zeros(3, dtype=PETSc.ScalarType),
                             fem.locate_dofs_topological(V, 2, tags.find(BOTTOM)), V)
     return V, tags, clamp

@@ -18,6 +18,7 @@ from mpi4py import MPI
 import dolfinx.cpp
 import ufl
 from dolfinx import fem
+from rough_contact.fem import compat
 from rough_contact.fem.collective import raise_on_all_ranks
 from rough_contact.fem.contact import ContactInterface
 from rough_contact.interface.contract import ConvergenceError, LawContractError
@@ -33,7 +34,7 @@ class LocalNewtonError(ConvergenceError):
 
 def _interface(law, comm=MPI.COMM_WORLD, degree=1):
     msh, tags = two_blocks(comm, n=(2, 2, 1))
-    V = fem.VectorFunctionSpace(msh, ("Lagrange", degree))
+    V = compat.vector_space(msh, degree)
     return V, ContactInterface(V, tags, LOWER_TOP, UPPER_BOTTOM, law=law)
 
 
@@ -153,14 +154,14 @@ def test_lifecycle_law_calls():
     interpolate_bodies(u, lambda x, up: smooth_field(x, up, 1e-3))
     ci.evaluate(u)
     assert law.calls == 1
-    b = dolfinx.cpp.la.petsc.create_vector(V.dofmap.index_map, 3)
+    b = compat.create_petsc_vector(V)
     ci.assemble_residual(b)
     mass = fem.form(ufl.inner(ufl.TrialFunction(V), ufl.TestFunction(V)) * ufl.dx)
     A = ci.create_matrix(mass)
     ci.assemble_jacobian(A)
     A.assemble()
     assert law.calls == 1
-    ci.evaluate(u.vector)             # the same u again: the law runs again
+    ci.evaluate(compat.petsc_vector(u))             # the same u again: the law runs again
     assert law.calls == 2
     assert ci.accept(u).done and law.calls == 3   # accept evaluates at the converged iterate
     ci.commit()

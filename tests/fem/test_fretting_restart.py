@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 from mpi4py import MPI
 
+from rough_contact.fem import compat
 from rough_contact.scenes import fretting
 
 SMALL = dict(cycles=1, steps_per_cycle=8, mesh_size=0.5, order=1)
@@ -70,7 +71,7 @@ def test_interface_stiffness_of_a_linear_penalty():
     from rough_contact.scenes.meshes.blocks import separate_blocks
 
     scene = separate_blocks(lx=2.0, ly=2.0, size_lower=0.5, size_upper=0.7)
-    V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", 1))
+    V = compat.vector_space(scene.mesh, 1)
     ci = ContactInterface(V, scene.facet_tags, *scene.contact_pair,
                           law=LinearPenalty(3e4, k_tangential=1e4), pairing="mortar")
     ci.evaluate(fem.Function(V))

@@ -15,6 +15,7 @@ import pytest
 from petsc4py import PETSc
 
 from dolfinx import fem
+from rough_contact.fem import compat
 from rough_contact.fem.contact import ContactInterface
 from rough_contact.fem.problem import ContactProblem, Material, SurfaceLoad
 from rough_contact.interface.penalty import SoftplusPenalty
@@ -29,7 +30,7 @@ TIMES = [0.5, 1.0, 1.25, 1.5, 1.75, 2.0]
 
 def _model(q_max):
     scene = two_blocks(h1=0.5, h2=0.5, mesh_size=0.5, order=1)
-    V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", 1))
+    V = compat.vector_space(scene.mesh, 1)
     clamp = fem.dirichletbc(np.zeros(3, dtype=PETSc.ScalarType), fem.locate_dofs_topological(
         V, 2, scene.facet_tags.find(scene.tag("bottom"))), V)
     law = SoftplusPenalty(k_normal=1e7, width=1e-9, k_tangential=1e7, friction=MU)

@@ -14,6 +14,7 @@ import pytest
 from mpi4py import MPI
 
 from dolfinx import fem
+from rough_contact.fem import compat
 from rough_contact.fem.contact import ContactInterface
 from rough_contact.fem.rigid import RigidPlane
 from rough_contact.interface.penalty import LinearPenalty
@@ -33,7 +34,7 @@ def test_sphere_on_block_against_hertz():
 
 def test_rigid_plane_surface_equals_rigid_plane_argument():
     msh, tags = two_blocks(MPI.COMM_WORLD, single=True)
-    V = fem.VectorFunctionSpace(msh, ("Lagrange", 2))
+    V = compat.vector_space(msh, 2)
     plane = ((0.1, -0.2, 0.3), (0.2, 0.1, 1.0))
     law = LinearPenalty(1e3, 2e2)
     a = ContactInterface(V, tags, LOWER_TOP, law=law, rigid_plane=plane)

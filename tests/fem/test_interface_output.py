@@ -26,6 +26,7 @@ from petsc4py import PETSc
 import dolfinx.mesh
 from dolfinx import fem
 
+from rough_contact.fem import compat
 from rough_contact.scenes.meshes.blocks import block_on_plane
 from rough_contact.scenes.meshes.flat_punch import flat_punch
 from rough_contact.fem.contact import ContactInterface
@@ -81,7 +82,7 @@ def run_punch(comm, outdir, prefix):
     Returns a dict of what the test compares the files with (global figures on every rank).
     """
     scene = flat_punch(mesh_size=20.0, contact_size=2.5, order=1, load_half_width=2.5, comm=comm)
-    V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", 1))
+    V = compat.vector_space(scene.mesh, 1)
 
     def dofs(name, comp=None):
         facets = scene.facet_tags.find(scene.tag(name))
@@ -313,7 +314,7 @@ def test_analytic_penalty_state_global_vectors(cell_type, order, grain, empty_ra
     lx, ly = 1.0, 2.0
     scene = block_on_plane(lx=lx, ly=ly, h=0.5, mesh_size=0.5, order=order, cell_type=cell_type,
                            comm=comm)
-    V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", order))
+    V = compat.vector_space(scene.mesh, order)
     kn, kt = 1.0e5, 3.0e4
     a, b, d = 2e-4, -1e-4, 5e-4
     contact = scene.tag("contact")
@@ -399,7 +400,7 @@ def test_overwrite_guard():
 def test_writer_refuses_earlier_files_and_bad_times():
     comm = MPI.COMM_WORLD
     scene = block_on_plane(lx=1.0, ly=1.0, h=0.5, mesh_size=0.6, comm=comm)
-    V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", 1))
+    V = compat.vector_space(scene.mesh, 1)
     ci = ContactInterface(V, scene.facet_tags, scene.tag("contact"), None,
                           law=LinearPenalty(1e5), rigid_plane=((0, 0, 0), (0, 0, 1)))
     ci.evaluate(fem.Function(V))
@@ -497,7 +498,7 @@ def _series(comm, path, times):
     from dolfinx.io import XDMFFile
 
     msh = dolfinx.mesh.create_unit_cube(comm, 2, 2, 2)
-    u = fem.Function(fem.VectorFunctionSpace(msh, ("Lagrange", 1)), name="u")
+    u = fem.Function(compat.vector_space(msh, 1), name="u")
     for k, t in enumerate(times):
         u.x.array[:] = t
         with XDMFFile(comm, path, "w" if k == 0 else "a") as f:

@@ -20,6 +20,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from dolfinx import fem
+from rough_contact.fem import compat
 from rough_contact.fem.contact import ContactInterface
 from rough_contact.fem.problem import (ContactProblem, Material, PrescribedDisplacement,
                                        SurfaceLoad)
@@ -36,7 +37,7 @@ MU, P, AMPLITUDE = 0.3, 100.0, 3e-3
 
 def _run(steps_per_cycle):
     scene = two_blocks(h1=0.5, h2=0.5, mesh_size=0.25, order=1)
-    V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", 1))
+    V = compat.vector_space(scene.mesh, 1)
     clamp = fem.dirichletbc(np.zeros(3, dtype=PETSc.ScalarType), fem.locate_dofs_topological(
         V, 2, scene.facet_tags.find(scene.tag("bottom"))), V)
     law = SoftplusPenalty(k_normal=1e7, width=1e-9, k_tangential=1e7, friction=MU)
@@ -78,7 +79,7 @@ def test_program_channels_and_bad_input():
 
 def test_programs_for_unknown_channels_are_refused():
     scene = two_blocks(h1=0.5, h2=0.5, mesh_size=0.5, order=1)
-    V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", 1))
+    V = compat.vector_space(scene.mesh, 1)
     with pytest.raises(ValueError, match=r"programs given for channel\(s\) \['cyclc'\] that no "
                        r"load or prescribed displacement uses; channels in use: \['preload'\]"):
         ContactProblem(V, Material(2e5, 0.3), [], [SurfaceLoad(scene.tag("top"),

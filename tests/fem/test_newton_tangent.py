@@ -9,6 +9,7 @@ import pytest
 from mpi4py import MPI
 from petsc4py import PETSc
 
+from rough_contact.fem import compat
 from rough_contact.interface.penalty import SoftplusPenalty
 from rough_contact.scenes import flat_punch
 from rough_contact.solver.loading import load_path, load_unload_factors
@@ -26,7 +27,7 @@ def _run(reversal_stiffness):
     factors = load_unload_factors(N_LOAD, N_LOAD - 1, final_factor=1.0 / N_LOAD)
     incs = list(load_path(m.problem, m.solver, factors, verbose=False))
     # partition-independent (two builds may partition the mesh differently)
-    u = np.array([m.problem.u.vector.norm(n) for n in (PETSc.NormType.NORM_1,
+    u = np.array([compat.petsc_vector(m.problem.u).norm(n) for n in (PETSc.NormType.NORM_1,
                                                       PETSc.NormType.NORM_2,
                                                       PETSc.NormType.NORM_INFINITY)])
     m.solver.destroy()

@@ -26,6 +26,7 @@ from petsc4py import PETSc
 
 import dolfinx
 from dolfinx import fem
+from rough_contact.fem import compat
 from rough_contact.fem.contact import ContactInterface
 from rough_contact.fem.problem import ContactProblem, Material, SurfaceLoad
 from rough_contact.interface.penalty import LinearPenalty, SoftplusPenalty
@@ -48,7 +49,7 @@ def patch(cell_type, order, size_lower, size_upper, first, pairing, law, E_lower
     largest pressure and shear errors (relative to p), the contact force and the interface."""
     scene = separate_blocks(h1=1.0, h2=0.5, size_lower=size_lower, size_upper=size_upper,
                             order=order, cell_type=cell_type, comm=comm)
-    V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", order))
+    V = compat.vector_space(scene.mesh, order)
     bcs = [roller(V, scene, "x0", 0), roller(V, scene, "y0", 1), roller(V, scene, "bottom", 2)]
     a, b = scene.contact_pair
     if first == "lower":
@@ -138,7 +139,7 @@ def _interpolate_bodies(u, scene):
 def _figures(comm, pairing, order=2, fd=False):
     scene = separate_blocks(h1=1.0, h2=0.5, size_lower=0.2, size_upper=0.28, order=order,
                             comm=comm)
-    V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", order))
+    V = compat.vector_space(scene.mesh, order)
     law = SoftplusPenalty(1e4, 1e-3, k_tangential=5e3, friction=0.2)
     moderate = pairing == "moderate"
     ci = ContactInterface(V, scene.facet_tags, *scene.contact_pair, law=law,
@@ -157,7 +158,7 @@ def _figures(comm, pairing, order=2, fd=False):
         ci.commit()          # a converged increment: the next one re-pairs
         ci.begin_increment(u)
         assert ci.comm.allreduce(ci.n_repairs, op=MPI.MAX) == 1
-    b = dolfinx.cpp.la.petsc.create_vector(V.dofmap.index_map, 3)
+    b = compat.create_petsc_vector(V)
     b.set(0.0)
     ci.evaluate(u)
     ci.assemble_residual(b)
@@ -171,7 +172,7 @@ def _figures(comm, pairing, order=2, fd=False):
     fd_err = None
     if fd:   # central differences of the residual along a random direction
         rng = np.random.default_rng(3)
-        x = u.vector.copy()
+        x = compat.petsc_vector(u).copy()
         d = x.duplicate()
         r0, r1 = d.getOwnershipRange()
         d.setArray(rng.uniform(-1, 1, 3 * V.dofmap.index_map.size_global)[r0:r1] * 1e-4)
@@ -210,7 +211,7 @@ def test_rank_independent_and_jacobian(pairing):
 def test_errors():
     comm = MPI.COMM_WORLD
     scene = separate_blocks(h1=1.0, h2=0.5, size_lower=0.5, size_upper=0.4, comm=comm)
-    V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", 1))
+    V = compat.vector_space(scene.mesh, 1)
     law = LinearPenalty(1.0)
     top, lower = scene.tag("top"), scene.tag("contact_lower")
     # the upper block's top faces up like the lower block's top: a wrong tag
@@ -280,7 +281,7 @@ def test_two_msh_files_make_one_scene(tmp_path):
     comm.Barrier()
     scene = scene_from_msh_files([lower, upper], comm,
                                  contact_pair=("upper_bottom", "lower_top"))
-    V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", 1))
+    V = compat.vector_space(scene.mesh, 1)
     bcs = [roller(V, scene, f"{b}_{s}", c) for b in ("lower", "upper")
            for s, c in (("x0", 0), ("y0", 1))] + [roller(V, scene, "lower_bottom", 2)]
     ci = ContactInterface(V, scene.facet_tags, *scene.contact_pair, law=LinearPenalty(1e6),
@@ -332,7 +333,7 @@ def test_two_xdmf_files_make_one_scene(tmp_path, order):
     assert scene.order == order and set(scene.bodies) == {"lower", "upper"}
     for name, value in (("lower", 1.0), ("upper", 0.5), ("upper_bottom", 1.0), ("lower_x0", 1.0)):
         assert measure_of(scene, name) == pytest.approx(value, rel=1e-10), name
-    V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", order))
+    V = compat.vector_space(scene.mesh, order)
     bcs = [roller(V, scene, f"{b}_{s}", c) for b in ("lower", "upper")
            for s, c in (("x0", 0), ("y0", 1))] + [roller(V, scene, "lower_bottom", 2)]
     ci = ContactInterface(V, scene.facet_tags, *scene.contact_pair, law=LinearPenalty(1e6),

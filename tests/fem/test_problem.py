@@ -12,6 +12,7 @@ from petsc4py import PETSc
 
 from dolfinx import fem
 
+from rough_contact.fem import compat
 from rough_contact.scenes.meshes.blocks import block_on_plane
 from rough_contact.fem.problem import ContactProblem, Material, SurfaceLoad, rigid_body_modes
 from rough_contact.solver.snes import SNESSolver
@@ -29,7 +30,7 @@ def roller(V, scene, name, comp):
 def test_bulk_uniaxial_exact(order):
     """One block on rollers, uniform pressure on top: the linear field is reproduced exactly."""
     scene = block_on_plane(lx=1.0, ly=2.0, h=1.5, mesh_size=0.6, order=order)
-    V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", order))
+    V = compat.vector_space(scene.mesh, order)
     bcs = [roller(V, scene, "x0", 0), roller(V, scene, "y0", 1), roller(V, scene, "contact", 2)]
     p = 50.0
     problem = ContactProblem(V, {scene.tag("block"): Material(E, NU)}, bcs,
@@ -51,7 +52,7 @@ def test_bulk_uniaxial_exact(order):
 def test_rigid_body_modes_in_kernel():
     """K (without Dirichlet conditions) annihilates the six rigid body modes."""
     scene = block_on_plane(lx=1.0, ly=1.0, h=1.0, mesh_size=0.6, order=1)
-    V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", 1))
+    V = compat.vector_space(scene.mesh, 1)
     problem = ContactProblem(V, Material(E, NU))
     ns = rigid_body_modes(V)
     assert ns.test(problem.K)
@@ -73,7 +74,7 @@ def test_bad_input_raises():
     with pytest.raises(ValueError, match=r"SurfaceLoad\(tag=2\)\.traction = \[1, 2\] is invalid"):
         SurfaceLoad(2, traction=[1, 2])
     scene = block_on_plane(lx=1.0, ly=1.0, h=1.0, mesh_size=0.6, order=1)
-    V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", 1))
+    V = compat.vector_space(scene.mesh, 1)
     with pytest.raises(ValueError, match=r"seating_stiffness = -1.0 MPa/mm is invalid: it must "
                                          r"be finite and >= 0"):
         ContactProblem(V, Material(E, NU), seating_stiffness=-1.0)
@@ -124,7 +125,7 @@ def blocks_problem(law, p, order=1, mesh_size=0.5, E_upper=E, E_lower=E, prefix=
                    comm=MPI.COMM_WORLD, **problem_kw):
     """Two blocks on rollers (x0, y0, bottom), pressure p [MPa] on top, interface law ``law``."""
     scene = two_blocks(lx=LX, ly=LY, h1=1.0, h2=0.5, mesh_size=mesh_size, order=order, comm=comm)
-    V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", order))
+    V = compat.vector_space(scene.mesh, order)
     bcs = [roller(V, scene, "x0", 0), roller(V, scene, "y0", 1), roller(V, scene, "bottom", 2)]
     first, second = scene.contact_pair
     ci = ContactInterface(V, scene.facet_tags, first, second, law=law, bcs=bcs,
@@ -222,7 +223,7 @@ def test_seating_spring_for_body_held_only_by_contact():
     Jacobian is singular; the Jacobian-only seating spring lets Newton start, and the converged
     answer is the exact one (uniform pressure p, penetration p / k_N)."""
     scene = block_on_plane(lx=LX, ly=LY, h=0.5, mesh_size=0.5, order=1)
-    V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", 1))
+    V = compat.vector_space(scene.mesh, 1)
     bcs = [roller(V, scene, "x0", 0), roller(V, scene, "y0", 1)]
     delta, p, kn = 1e-3, 10.0, 1e5
     law = LinearPenalty(kn, unilateral=True)

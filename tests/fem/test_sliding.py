@@ -20,6 +20,7 @@ from petsc4py import PETSc
 
 from dolfinx import fem
 from dolfinx.fem import petsc as fem_petsc
+from rough_contact.fem import compat
 from rough_contact.fem.contact import ContactInterface
 from rough_contact.fem.problem import (ContactProblem, Material, PrescribedDisplacement,
                                        SurfaceLoad)
@@ -54,7 +55,7 @@ def _scene():
 def _run(sliding, friction=0.0, **path):
     comm = MPI.COMM_WORLD
     scene = _scene()
-    V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", 1))
+    V = compat.vector_space(scene.mesh, 1)
 
     def roller(name):
         dofs = fem.locate_dofs_topological(V.sub(1), 2, scene.facet_tags.find(scene.tag(name)))
@@ -121,7 +122,7 @@ def test_slider_in_gross_slip_transmits_mu_p():
 
 def test_moderate_sliding_refuses_what_it_cannot_do():
     scene = slider_on_slab(comm=MPI.COMM_WORLD)
-    V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", 1))
+    V = compat.vector_space(scene.mesh, 1)
     law = SoftplusPenalty(1e6, 1e-5)
     with pytest.raises(ValueError, match="sliding = 'moderate' needs a deformable second"):
         ContactInterface(V, scene.facet_tags, *scene.contact_pair, law=law, sliding="moderate",

@@ -13,6 +13,7 @@ import pytest
 from petsc4py import PETSc
 
 from dolfinx import fem
+from rough_contact.fem import compat
 from rough_contact.scenes.meshes.blocks import block_on_plane
 from rough_contact.fem.problem import ContactProblem, Material, SurfaceLoad
 from rough_contact.solver.options import unused_options
@@ -25,7 +26,7 @@ E, NU = 2.0e5, 0.25
 def bulk_problem(p, mesh_size=0.6):
     """One block on rollers with pressure p [MPa] on top (a linear problem)."""
     scene = block_on_plane(lx=1.0, ly=2.0, h=1.5, mesh_size=mesh_size, order=1)
-    V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", 1))
+    V = compat.vector_space(scene.mesh, 1)
     bcs = []
     for name, comp in (("x0", 0), ("y0", 1), ("contact", 2)):
         dofs = fem.locate_dofs_topological(V.sub(comp), 2,

@@ -17,6 +17,7 @@ import pytest
 from mpi4py import MPI
 
 from dolfinx import fem
+from rough_contact.fem import compat
 from rough_contact.fem.contact import ContactInterface
 from rough_contact.interface.penalty import LinearPenalty, SoftplusPenalty
 from rough_contact.solver.loading import load_path, load_unload_factors
@@ -27,7 +28,7 @@ from test_contact import (LOWER_TOP, UPPER_BOTTOM, fd_check, interpolate_bodies,
 
 def _interface(law, n=(3, 2, 1), size=(1.3, 0.7, 0.4), degree=1):
     msh, tags = two_blocks(MPI.COMM_WORLD, n=n, size=size)
-    V = fem.VectorFunctionSpace(msh, ("Lagrange", degree))
+    V = compat.vector_space(msh, degree)
     return V, ContactInterface(V, tags, LOWER_TOP, UPPER_BOTTOM, law=law, quadrature="vertex")
 
 
@@ -80,7 +81,7 @@ def test_vertex_rule_is_refused_for_p2_and_bad_names():
     with pytest.raises(ValueError, match="quadrature = 'vertex' needs a degree-1 space"):
         _interface(LinearPenalty(1.0), degree=2)
     msh, tags = two_blocks(MPI.COMM_WORLD)
-    V = fem.VectorFunctionSpace(msh, ("Lagrange", 1))
+    V = compat.vector_space(msh, 1)
     with pytest.raises(ValueError, match="quadrature = 'lobatto' is invalid"):
         ContactInterface(V, tags, LOWER_TOP, UPPER_BOTTOM, law=LinearPenalty(1.0),
                          quadrature="lobatto")
