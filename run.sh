@@ -141,6 +141,7 @@ debian13_umount() {
 }
 
 debian13_run() {    # debian13_run CMD...: `bash run.sh CMD...` inside the chroot (CMD=shell: a shell)
+    local t0=$SECONDS
     debian13_build
     local root="$DEBIAN13_ROOT"
     # One run at a time per machine: the mount points are shared.
@@ -176,10 +177,13 @@ debian13_run() {    # debian13_run CMD...: `bash run.sh CMD...` inside the chroo
              OMPI_ALLOW_RUN_AS_ROOT OMPI_ALLOW_RUN_AS_ROOT_CONFIRM MPLBACKEND; do
         [ -z "${!v+x}" ] || envs+=("$v=${!v}")
     done
+    echo "[debian13] chroot ready in $((SECONDS - t0)) s (Debian $(. "$root/etc/os-release" && echo "$VERSION_ID"))"
     local rc=0
+    t0=$SECONDS
     chroot "$root" /usr/bin/env -i "${envs[@]}" bash -c 'cd "$0" && exec "$@"' \
         "$DEBIAN13_REPO" "${inner[@]}" || rc=$?
     debian13_umount
+    echo "[debian13] \`bash run.sh $*\` in the chroot: $((SECONDS - t0)) s, exit $rc"
     return $rc
 }
 
