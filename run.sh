@@ -127,6 +127,7 @@ debian13_build() {
         exit 1
     fi
     mv -T "$tmp" "$DEBIAN13_ROOT"
+    mv "$tmp.log" "$DEBIAN13_ROOT.build.log"
     echo "[debian13] root file system built in $((SECONDS - t0)) s"
 }
 
@@ -166,7 +167,7 @@ debian13_run() {    # debian13_run CMD...: `bash run.sh CMD...` inside the chroo
         [ -f "$crt" ] || continue
         cmp -s "$crt" "$root$crt" || { mkdir -p "$root${crt%/*}"; cp "$crt" "$root$crt"; changed=1; }
     done
-    [ $changed -eq 0 ] || chroot "$root" /usr/sbin/update-ca-certificates > /dev/null
+    [ $changed -eq 0 ] || chroot "$root" /usr/sbin/update-ca-certificates > /dev/null 2>&1
     local inner=(bash run.sh "$@")
     [ "${1:-}" = shell ] && inner=(bash -l)
     # A clean environment: only what the project reads is passed on.
