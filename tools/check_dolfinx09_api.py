@@ -71,7 +71,7 @@ class Fx:
 
     @staticmethod
     def _gmsh_p2():
-        """A P2 tetrahedral cube from gmsh on rank 0 as arrays, tags: volume 1, bottom 10, top 11."""
+        """P2 tetrahedral unit cube from gmsh (rank 0) as arrays; volume 1, bottom 10, top 11."""
         import gmsh
         data = None
         if comm.rank == 0:
@@ -145,7 +145,7 @@ class Fx:
 
     @staticmethod
     def _elasticity():
-        """Forms, bcs of a small linear-elastic problem on the P2 scene (bottom clamped, top load)."""
+        """Forms, bcs of a linear-elastic problem on the P2 scene (bottom clamped, top load)."""
         msh, ct, ft = Fx.get("scene")
         V = Fx.get("V2")
         u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
@@ -343,7 +343,8 @@ def _():
     assert Fx.get("msh1").geometry.cmap.degree == 1
 
 
-@check("msh.geometry.dofmap.array.reshape(num_nodes, -1)", "msh.geometry.dofmap  ((n_cells, 10) int32)")
+@check("msh.geometry.dofmap.array.reshape(num_nodes, -1)",
+       "msh.geometry.dofmap  ((n_cells, 10) int32)")
 def _():
     dm = Fx.get("scene")[0].geometry.dofmap
     assert isinstance(dm, np.ndarray) and dm.shape[1] == 10
@@ -406,7 +407,6 @@ def _():
        "values)")
 def _():
     msh, ct, ft = Fx.get("scene")
-    assert not hasattr(dolfinx.cpp.graph, "AdjacencyList_int32") or True
     nown = msh.topology.index_map(2).size_local
     for tag in (10, 11):
         f = ft.find(tag)
@@ -519,7 +519,8 @@ def _():
     assert np.isfinite(b.norm())
 
 
-@check("fem.petsc.set_bc(b, bcs, x0, scale)", "fem.petsc.set_bc(b, bcs, x0, alpha)  (scale -> alpha)")
+@check("fem.petsc.set_bc(b, bcs, x0, scale)",
+       "fem.petsc.set_bc(b, bcs, x0, alpha)  (scale -> alpha)")
 def _():
     e = Fx.get("elasticity")
     b = dolfinx.fem.petsc.assemble_vector(e["L"])
@@ -789,7 +790,8 @@ def _():
 
 
 @check("(no VTX on 0.5.2 from Debian 12)",
-       "dolfinx.io.VTXWriter(comm, \"u.bp\", [u], engine=\"BP4\"); .write(t)  (ADIOS2 in Debian 13: "
+       "dolfinx.io.VTXWriter(comm, \"u.bp\", [u], engine=\"BP4\"); .write(t)  "
+       "(ADIOS2 in Debian 13: "
        "P2 on P1 mesh allowed)")
 def _():
     assert dolfinx.common.has_adios2
