@@ -109,7 +109,6 @@ PYEOF
 # `bash run.sh ...` does its set-up with Debian 13's packages and a venv in the chroot.
 debian13_build() {
     [ -d "$DEBIAN13_ROOT" ] && return 0
-    [ "$(id -u)" -eq 0 ] || { echo "[debian13] building and entering the chroot needs root" >&2; exit 1; }
     if ! command -v mmdebstrap > /dev/null; then
         echo "[debian13] installing mmdebstrap"
         apt-get update -qq
@@ -143,11 +142,13 @@ debian13_umount() {
 
 debian13_run() {    # debian13_run CMD...: `bash run.sh CMD...` inside the chroot (CMD=shell: a shell)
     local t0=$SECONDS
-    debian13_build
     local root="$DEBIAN13_ROOT"
-    # One run at a time per machine: the mount points are shared.
+    [ "$(id -u)" -eq 0 ] || { echo "[debian13] building and entering the chroot needs root" >&2; exit 1; }
+    # One build or run at a time per machine: the root file system and its mount points are shared.
+    mkdir -p "$(dirname "$root")"
     exec 9> "$root.lock"
     flock -w 3600 9 || { echo "[debian13] another run holds $root.lock" >&2; exit 1; }
+    debian13_build
     trap debian13_umount EXIT
     trap 'exit 130' INT
     trap 'exit 143' TERM
