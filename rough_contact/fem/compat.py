@@ -20,8 +20,11 @@ from typing import Sequence
 import numpy as np
 
 import dolfinx
+import dolfinx.cpp
 import dolfinx.fem
 import dolfinx.fem.petsc
+import dolfinx.graph
+import dolfinx.io
 import dolfinx.la
 import dolfinx.mesh
 
@@ -89,7 +92,6 @@ def create_petsc_vector(V):
     imap, bs = V.dofmap.index_map, V.dofmap.index_map_bs
     if NEW_API:
         return dolfinx.la.create_petsc_vector(imap, bs)
-    import dolfinx.cpp
     return dolfinx.cpp.la.petsc.create_vector(imap, bs)
 
 
@@ -191,13 +193,10 @@ def meshtags_from_arrays(msh, dim: int, entities: np.ndarray, values: np.ndarray
     """MeshTags of dimension ``dim`` from rank-0 entity arrays (vertices in DOLFINx order,
     original input node numbers) and their values (collective)."""
     if NEW_API:
-        import dolfinx.graph
-        import dolfinx.io
         ents, vals = dolfinx.io.distribute_entity_data(msh, dim, entities,
                                                        np.asarray(values, dtype=np.int32))
         adjacency = dolfinx.graph.adjacencylist(ents)
     else:
-        import dolfinx.cpp
         ents, vals = dolfinx.cpp.io.distribute_entity_data(msh._mesh, dim, entities, values)
         adjacency = dolfinx.cpp.graph.AdjacencyList_int32(ents)
     return dolfinx.mesh.meshtags_from_entities(msh, dim, adjacency, np.asarray(vals, np.int32))
@@ -208,7 +207,6 @@ def facet_geometry_nodes(msh, facets: np.ndarray) -> np.ndarray:
     fdim = msh.topology.dim - 1
     if NEW_API:
         return dolfinx.mesh.entities_to_geometry(msh, fdim, np.asarray(facets, np.int32), False)
-    import dolfinx.cpp
     return dolfinx.cpp.mesh.entities_to_geometry(msh._mesh, fdim, facets, False)
 
 

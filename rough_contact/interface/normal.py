@@ -162,7 +162,7 @@ class NormalLaw:
         m = int(np.ceil(span / dx.min() * (1.0 + 1e-9))) + 1
         if m > _MAX_LUT:
             raise ValueError(f"table knots too uneven: the look-up table would need {m} cells "
-                             f"(valid range: <= {_MAX_LUT}); shortest interval {dx.min()!r} mm "
+                             f"(valid range: <= {_MAX_LUT}); shortest interval {float(dx.min())!r} mm "
                              f"over {span!r} mm")
         lut_inv = m / span
         edges = h[0] + np.arange(m + 1) / lut_inv
@@ -421,7 +421,7 @@ class NormalLaw:
                                      "to -inf; valid range: (-inf, inf] mm")
                 raise ValueError(
                     f"{int((d > self._d_max).sum())} separations below "
-                    f"{h0 - self._d_max!r} mm (e.g. {h[lo][np.argmax(d)]!r} mm): the penalty "
+                    f"{float(h0 - self._d_max)!r} mm (e.g. {float(h[lo][np.argmax(d)])!r} mm): the penalty "
                     "continuation would overflow there; the iteration has diverged")
             p[lo] = self._p0 + d * (self._k0 + 0.5 * self._c0 * d)
             k[lo] = self._k0 + self._c0 * d
@@ -473,7 +473,7 @@ class NormalLaw:
         if bad.any():
             j = int(np.flatnonzero(bad.ravel())[0])
             raise ValueError(f"pressure p has {int(bad.sum())} entries outside the valid range "
-                             f"[0, inf) MPa, e.g. {p.ravel()[j]!r}")
+                             f"[0, inf) MPa, e.g. {float(p.ravel()[j])!r}")
         pf = p.ravel()
         out = np.empty_like(pf)
         knots = self.knots

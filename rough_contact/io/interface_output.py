@@ -384,7 +384,7 @@ def pseudo_time(load_factors: Sequence[float]) -> np.ndarray:
     steps = np.abs(np.diff(np.r_[0.0, lam]))
     if np.any(steps == 0.0):
         i = int(np.argmin(steps))
-        raise ValueError(f"load factor {lam[i]!r} repeats at written step {i + 1}: the time "
+        raise ValueError(f"load factor {float(lam[i])!r} repeats at written step {i + 1}: the time "
                          "value must increase; pass time= explicitly")
     t = np.cumsum(steps)
     monotone = np.cumprod(np.r_[0.0, lam][1:] > np.r_[0.0, lam][:-1]).astype(bool)
@@ -518,7 +518,7 @@ class InterfaceWriter:
     # ------------------------------------------------------------------ XML
     def _grid(self, k: int, mesh_items: list, items: list, center: str) -> list:
         lines = [f'      <Grid Name="step_{k + 1}" GridType="Uniform">',
-                 f'        <Time Value="{self.times[k]!r}"/>'] + mesh_items
+                 f'        <Time Value="{float(self.times[k])!r}"/>'] + mesh_items
         for name, path, (shape, dtype) in items:
             kind = "Scalar" if len(shape) == 1 else "Vector"
             lines.append(f'        <Attribute Name="{name}" AttributeType="{kind}" '

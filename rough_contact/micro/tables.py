@@ -392,7 +392,7 @@ def _adaptive_table(model: Model, h_lo: float, h_hi: float, rtol: float, n_initi
         if np.any(np.diff(q) > 0):
             j = int(np.flatnonzero(np.diff(q) > 0)[0])
             raise ValueError(
-                f"model pressure is not non-increasing: p({h[j]!r} mm) = {p[j]!r} MPa < "
+                f"model pressure is not non-increasing: p({float(h[j])!r} mm) = {float(p[j])!r} MPa < "
                 f"p({h[j + 1]!r} mm) = {p[j + 1]!r} MPa")
         dla = limited_slopes(h, la)
         cq = hermite_coeffs(q[:-1], q[1:], dq[:-1], dq[1:], dxs)
@@ -582,10 +582,10 @@ def tabulate_data(h, p, a=None, k=None) -> Table:
                          f"h[{j + 1}] = {h[j + 1]!r} mm")
     if np.any(p <= 0):
         j = int(np.flatnonzero(p <= 0)[0])
-        raise ValueError(f"table p[{j}] = {p[j]!r} MPa is outside the valid range (0, inf)")
+        raise ValueError(f"table p[{j}] = {float(p[j])!r} MPa is outside the valid range (0, inf)")
     if np.any(np.diff(p) >= 0):
         j = int(np.flatnonzero(np.diff(p) >= 0)[0])
-        raise ValueError(f"table p must be strictly decreasing in h: p[{j}] = {p[j]!r}, "
+        raise ValueError(f"table p must be strictly decreasing in h: p[{j}] = {float(p[j])!r}, "
                          f"p[{j + 1}] = {p[j + 1]!r} MPa")
     q = np.log(p)
     if k is not None:
