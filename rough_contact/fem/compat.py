@@ -183,10 +183,27 @@ def mesh_domain(cell_name: str, degree: int):
         ufl.FiniteElement("Lagrange", cell, int(degree), variant="equispaced")))
 
 
-def create_mesh(comm, cells: np.ndarray, x: np.ndarray, cell_name: str, degree: int):
-    """A distributed mesh from rank-0 arrays (cells in DOLFINx node order, int64)."""
-    return dolfinx.mesh.create_mesh(comm, np.asarray(cells, dtype=np.int64), x,
-                                    mesh_domain(cell_name, degree))
+def create_mesh(comm, cells: np.ndarray, x: np.ndarray, cell_name: str, degree: int,
+                destinations=None):
+    """A distributed mesh from input arrays (cells in DOLFINx node order, int64).
+
+    ``destinations(n_cells, n_ranks) -> (n_cells,) int32``, if given, chooses the rank of every
+    input cell of the calling rank (instead of the graph partitioner)."""
+    cells = np.asarray(cells, dtype=np.int64)
+    domain = mesh_domain(cell_name, degree)
+    if destinations is None:
+        return dolfinx.mesh.create_mesh(comm, cells, x, domain)
+    n_per_cell = cells.shape[1]
+    if NEW_API:
+        def partitioner(comm_, nparts, cell_types, local_cells):
+            n = int(np.asarray(local_cells[0]).size // n_per_cell)
+            return dolfinx.graph.adjacencylist(
+                np.asarray(destinations(n, nparts), dtype=np.int32).reshape(-1, 1))
+    else:
+        def partitioner(comm_, nparts, tdim, local_cells, ghost_mode):
+            dest = np.asarray(destinations(local_cells.num_nodes, nparts), dtype=np.int32)
+            return dolfinx.cpp.graph.AdjacencyList_int32(dest.reshape(-1, 1))
+    return dolfinx.mesh.create_mesh(comm, cells, x, domain, partitioner=partitioner)
 
 
 def meshtags_from_arrays(msh, dim: int, entities: np.ndarray, values: np.ndarray):

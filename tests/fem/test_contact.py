@@ -58,16 +58,14 @@ def two_blocks(comm, n=(3, 3, 2), size=(1.0, 1.0, 0.5), single=False, split=Fals
             X, T = np.vstack([X1, X2]), np.vstack([T1, T2])
     else:
         X, T = np.zeros((0, 3)), np.zeros((0, 4), dtype=np.int64)
-    domain = ufl.Mesh(ufl.VectorElement("Lagrange", ufl.tetrahedron, 1))
     if split:
-        def partitioner(comm_, nparts, tdim_, cells, ghost_mode):
-            half = cells.num_nodes // 2  # lower cells first, then upper ones
-            dest = np.where(np.arange(cells.num_nodes) < half, 0, nparts - 1).astype(np.int32)
-            return dolfinx.cpp.graph.AdjacencyList_int32(dest.reshape(-1, 1))
+        def destinations(n_cells, nparts):
+            half = n_cells // 2  # lower cells first, then upper ones
+            return np.where(np.arange(n_cells) < half, 0, nparts - 1)
 
-        msh = dmesh.create_mesh(comm, T.astype(np.int64), X, domain, partitioner=partitioner)
+        msh = compat.create_mesh(comm, T, X, "tetrahedron", 1, destinations=destinations)
     else:
-        msh = dmesh.create_mesh(comm, T.astype(np.int64), X, domain)
+        msh = compat.create_mesh(comm, T, X, "tetrahedron", 1)
     tdim = 3
     msh.topology.create_connectivity(tdim - 1, tdim)
     bfacets = dmesh.exterior_facet_indices(msh.topology)
@@ -266,7 +264,7 @@ def test_uniform_jump_patch():
     b = residual(ci, V, u)
     r0, r1 = b.getOwnershipRange()
     n_own = V.dofmap.index_map.size_local
-    up_nodes = np.unique(V.dofmap.list.array.reshape(-1, 10)[upper_cells(msh)].ravel())
+    up_nodes = np.unique(compat.cell_dofmap(V)[upper_cells(msh)].ravel())
     upper = np.zeros(n_own, dtype=bool)
     upper[up_nodes[up_nodes < n_own]] = True
     upper = np.repeat(upper, 3)

@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 from mpi4py import MPI
 
+from rough_contact.fem import compat
 from rough_contact.scenes.meshes.beam import beam_on_base
 from rough_contact.scenes.meshes.blocks import block_on_plane, two_blocks
 from rough_contact.scenes.meshes.flat_punch import flat_punch
@@ -301,7 +302,7 @@ def _global_node_count(scene) -> int:
 def _used_nodes_global(scene) -> int:
     """Distinct geometry nodes referenced by the cells, counted over all ranks."""
     g = scene.mesh.geometry
-    local = np.unique(g.dofmap.array)
+    local = np.unique(compat.geometry_dofmap(scene.mesh))
     owned = local[local < g.index_map().size_local]
     return COMM.allreduce(int(owned.size))
 
