@@ -117,3 +117,18 @@ def prepare_output_dir(outdir: str, comm: MPI.Comm = MPI.COMM_WORLD, overwrite: 
         return found
 
     return run_on_root(comm, act)
+
+
+_XI = "http://www.w3.org/2001/XInclude"
+
+
+def parse_xdmf(path: str):
+    """The root element of an XDMF file. DOLFINx 0.9 writes ``<xi:include>`` elements without
+    declaring the ``xi`` prefix (0.5.2 declares it); the declaration is added before parsing."""
+    import xml.etree.ElementTree as ET
+    ET.register_namespace("xi", _XI)
+    with open(path, encoding="utf-8") as f:
+        xml = f.read()
+    if "xi:" in xml and "xmlns:xi" not in xml:
+        xml = xml.replace("<Xdmf ", f'<Xdmf xmlns:xi="{_XI}" ', 1)
+    return ET.fromstring(xml)

@@ -60,7 +60,7 @@ from mpi4py import MPI
 from rough_contact.fem import compat
 from rough_contact.fem.collective import run_on_root
 from rough_contact.fem.contact import PointFields
-from rough_contact.io.files import OutputExistsError, atomic_write_text, run_files
+from rough_contact.io.files import OutputExistsError, atomic_write_text, parse_xdmf, run_files
 
 __all__ = [
     "STATUS_OPEN", "STATUS_STICK", "STATUS_SLIP", "STATUS_NAMES", "InterfaceOutputSource",
@@ -686,7 +686,7 @@ def read_interface_results(path: str) -> InterfaceResults:
     import h5py
 
     folder = os.path.dirname(os.path.abspath(path))
-    root = ET.parse(path).getroot()
+    root = parse_xdmf(path)
     grids = root.findall("./Domain/Grid/Grid")
     if not grids:
         raise ValueError(f"{path!r} holds no written step")

@@ -42,7 +42,7 @@ from dolfinx import fem
 from dolfinx.io import XDMFFile
 from rough_contact.fem import compat
 from rough_contact.fem.collective import run_on_root
-from rough_contact.io.files import atomic_write, atomic_write_text, prepare_output_dir
+from rough_contact.io.files import atomic_write, atomic_write_text, parse_xdmf, prepare_output_dir
 from rough_contact.io.interface_output import InterfaceWriter, pseudo_time
 
 __all__ = ["ResultWriter", "CsvRecorder", "gather_points", "truncate_time_series"]
@@ -69,7 +69,6 @@ def gather_points(comm: MPI.Comm, points: np.ndarray, fields: dict, root: int = 
     return pts, out
 
 
-_XI = "http://www.w3.org/2001/XInclude"
 
 
 def truncate_time_series(path: str, n_keep: int) -> bool:
@@ -88,8 +87,7 @@ def truncate_time_series(path: str, n_keep: int) -> bool:
     if not os.path.exists(path):
         return False
     try:
-        ET.register_namespace("xi", _XI)
-        root = ET.parse(path).getroot()
+        root = parse_xdmf(path)
         dropped, kept = set(), set()
         for series in root.iter("Grid"):
             if series.get("CollectionType") != "Temporal":

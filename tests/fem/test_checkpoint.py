@@ -83,11 +83,11 @@ def _csv(path):
 def _xdmf_steps(path):
     """(time values, {time: displacement array}) of a DOLFINx XDMF time series."""
     import os
-    import xml.etree.ElementTree as ET
-
     import h5py
 
-    root = ET.parse(path).getroot()
+    from rough_contact.io.files import parse_xdmf
+
+    root = parse_xdmf(path)
     times, data = [], {}
     h5 = os.path.splitext(path)[0] + ".h5"
     with h5py.File(h5, "r") as f:
@@ -170,7 +170,7 @@ def test_resume_refuses_another_problem(tmp_path):
         pass
     solver.destroy()
     other, solver = _model(mesh_size=0.35)
-    with pytest.raises(CheckpointError, match="written by another problem .*num_dofs"):
+    with pytest.raises(CheckpointError, match="written by another problem .*(num_dofs|dof_checksum)"):
         next(load_path(other, solver, PROGRAM.times[:2], resume=directory))
     solver.destroy()
     problem, solver = _model()
