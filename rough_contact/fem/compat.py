@@ -28,7 +28,7 @@ import dolfinx.io
 import dolfinx.la
 import dolfinx.mesh
 
-__all__ = ["DOLFINX_VERSION", "NEW_API", "vector_space", "petsc_vector", "function_values",
+__all__ = ["DOLFINX_VERSION", "NEW_API", "vector_space", "petsc_vector", "function_values", "interpolate",
            "element_degree", "geometry_degree", "geometry_dofmap", "cell_dofmap",
            "create_petsc_vector", "form_sparsity", "block_csr_matrix", "near_nullspace",
            "mesh_domain", "create_mesh", "meshtags_from_arrays", "facet_geometry_nodes",
@@ -62,6 +62,16 @@ def petsc_vector(u):
 def function_values(u) -> np.ndarray:
     """The local values (owned and ghost) of the Function ``u``, a flat array view."""
     return u.x.array
+
+
+def interpolate(u, f, cells=None) -> None:
+    """``u.interpolate(f)`` on the given local cells only (all cells if None)."""
+    if cells is None:
+        u.interpolate(f)
+    elif NEW_API:
+        u.interpolate(f, cells0=np.asarray(cells, dtype=np.int32))
+    else:
+        u.interpolate(f, cells=cells)
 
 
 def element_degree(V) -> int:

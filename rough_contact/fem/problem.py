@@ -205,6 +205,10 @@ class ContactProblem:
             load factor (pseudo-time) t; a channel without a program follows t itself (today's
             proportional loading). See ``rough_contact.solver.program`` for preload, hold and
             cyclic programs.
+        forms: ``(a, L)``, the user's own UFL forms instead of ``materials`` and ``loads``: the
+            bilinear form a(u, v) of the bulk (linear in u; trial and test functions of V) and
+            the linear form L(v) of the external loads, which forms the load channel
+            ``"load"`` (scaled by the load factor or its program); ``materials`` must be None.
 
     Raises:
         TypeError: ``interface`` is neither a ContactInterface nor None.
@@ -226,6 +230,7 @@ class ContactProblem:
         body_cells: Sequence[np.ndarray] = (),
         prescribed: Sequence[PrescribedDisplacement] = (),
         programs: Optional[dict] = None,
+        forms: Optional[tuple] = None,
     ):
         if interface is not None and not isinstance(interface, ContactInterface):
             raise TypeError(f"interface must be a ContactInterface or None, got "
@@ -242,7 +247,17 @@ class ContactProblem:
             if not callable(fn):
                 raise TypeError(f"programs[{name!r}] must be a callable t -> scale, got "
                                 f"{type(fn).__name__}")
+        if forms is not None:
+            if materials is not None or loads:
+                raise ValueError("give either forms=(a, L) or materials and loads, not both")
+            self._user_forms = tuple(forms)
+            if len(self._user_forms) != 2:
+                raise ValueError(f"forms must be (a, L), got {len(self._user_forms)} item(s)")
+        else:
+            self._user_forms = None
         used = {x.channel for x in list(loads) + list(prescribed)}
+        if forms is not None:
+            used.add("load")
         unknown = sorted(set(self.programs) - used)
         if unknown:
             raise ValueError(f"programs given for channel(s) {unknown} that no load or prescribed "
@@ -269,8 +284,17 @@ class ContactProblem:
 
     # ------------------------------------------------------------------ set-up steps
     def _bulk_form(self, materials, cell_tags, facet_tags, quadrature_degree) -> None:
-        """The bilinear form of linear elasticity, per body; the measures."""
+        """The bilinear form of linear elasticity, per body (or the user's); the measures."""
         msh, V = self.mesh, self.V
+        self._ds = ufl.Measure("ds", domain=msh, subdomain_data=facet_tags)
+        if self._user_forms is not None:
+            a = self._user_forms[0]
+            v, u = a.arguments()
+            self.materials = {}
+            self._u_trial = u
+            self.a = fem.form(a)
+            self._a_ufl, self._v = a, v
+            return
         if isinstance(materials, Material):
             materials = {None: materials}
         elif not materials:
@@ -280,14 +304,11 @@ class ContactProblem:
         self.materials = dict(materials)
         md = {} if quadrature_degree is None else {"quadrature_degree": quadrature_degree}
         dx = ufl.Measure("dx", domain=msh, subdomain_data=cell_tags, metadata=md)
-        ds = ufl.Measure("ds", domain=msh, subdomain_data=facet_tags)
-
         u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
 
         def eps(w):
             return ufl.sym(ufl.grad(w))
 
-        self._ds = ds
         self._u_trial = u
         a = 0
         for tag, mat in self.materials.items():
@@ -305,6 +326,14 @@ class ContactProblem:
         self.applied_force = np.zeros(3)          # all channels at scale 1
         self._channel_force = {}
         L, L_channel = 0, {}
+        if self._user_forms is not None:          # the user's load form: channel "load"
+            L = L_channel["load"] = self._user_forms[1]
+            full = fem_petsc.assemble_vector(fem.form(L))
+            full.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+            nodal = full.getArray(readonly=True).reshape(-1, 3)
+            self.applied_force = self.comm.allreduce(nodal.sum(axis=0), op=MPI.SUM)
+            self._channel_force["load"] = self.applied_force.copy()
+            full.destroy()
         for load in self.loads:
             if facet_tags is None:
                 raise ValueError("surface loads need facet_tags")

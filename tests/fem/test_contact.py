@@ -97,8 +97,8 @@ def interpolate_bodies(u, f):
     up = upper_cells(msh)
     n = msh.topology.index_map(3).size_local + msh.topology.index_map(3).num_ghosts
     low = np.setdiff1d(np.arange(n, dtype=np.int32), up)
-    u.interpolate(lambda x: f(x, 0.0), cells=low)
-    u.interpolate(lambda x: f(x, 1.0), cells=up)
+    compat.interpolate(u, lambda x: f(x, 0.0), cells=low)
+    compat.interpolate(u, lambda x: f(x, 1.0), cells=up)
     u.x.scatter_forward()
 
 
@@ -428,7 +428,7 @@ def test_uniform_jump_patch_gmsh_scene(cell_type, order):
     d = np.array([2e-3, -1e-3, -5e-4])
     u = fem.Function(V)
     upper = sc.cell_tags.find(sc.tag("upper"))
-    u.interpolate(lambda x: np.outer(d, np.ones(x.shape[1])), cells=upper)
+    compat.interpolate(u, lambda x: np.outer(d, np.ones(x.shape[1])), cells=upper)
     ci.evaluate(u)
     # the upper body moved by d relative to the lower one: the springs pull it back
     np.testing.assert_allclose(ci.contact_force(), -np.array([kt, kt, kn]) * d * lx * ly,

@@ -129,7 +129,7 @@ def _interpolate_bodies(u, scene):
     upper = scene.cell_tags.find(scene.tag("upper"))
     lower = scene.cell_tags.find(scene.tag("lower"))
     for cells, s in ((lower, 0.0), (upper, 1.0)):
-        u.interpolate(lambda x: 2e-3 * np.stack([
+        compat.interpolate(u, lambda x: 2e-3 * np.stack([
             np.sin(2 * x[0] + 1) * np.cos(x[1]) + 0.5 * s * np.cos(3 * x[1]),
             np.cos(x[0] - 2 * x[1]) - 0.3 * s * np.sin(x[0]),
             np.sin(x[0] + x[1] + x[2]) - 0.8 * s * (1 + x[0] * x[1])]), cells=cells)
@@ -151,8 +151,8 @@ def _figures(comm, pairing, order=2, fd=False):
     if moderate:    # the upper face slid by up to 0.07 mm (a quarter element), 0 at its
         upper = scene.cell_tags.find(scene.tag("upper"))   # edges: it stays over the lower one
         shift = fem.Function(V)
-        shift.interpolate(lambda x: np.stack([0.07 * np.sin(np.pi * x[0]), 0 * x[0], 0 * x[0]]),
-                          cells=upper)
+        compat.interpolate(shift, lambda x: np.stack([0.07 * np.sin(np.pi * x[0]), 0 * x[0],
+                                                       0 * x[0]]), cells=upper)
         u.x.array[:] += shift.x.array
         u.x.scatter_forward()
         ci.commit()          # a converged increment: the next one re-pairs
