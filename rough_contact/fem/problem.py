@@ -280,6 +280,7 @@ class ContactProblem:
         self.u.x.scatter_forward()
         self.b = self.f.duplicate()
         self.counters = {"residual": 0, "jacobian": 0}
+        self.callback_error: Optional[BaseException] = None   # see F
         self.timings = {"bulk": 0.0, "interface_residual": 0.0, "interface_jacobian": 0.0}
 
     # ------------------------------------------------------------------ set-up steps
@@ -438,7 +439,18 @@ class ContactProblem:
             self.rebuild_matrices()
 
     def F(self, snes, x: PETSc.Vec, b: PETSc.Vec) -> None:
-        """Residual ``b = K x - lam f + lift + R_c(x)``, with ``b = x - g`` on Dirichlet rows."""
+        """Residual ``b = K x - lam f + lift + R_c(x)``, with ``b = x - g`` on Dirichlet rows.
+
+        An exception is kept in :attr:`callback_error` before it propagates: petsc4py 3.22
+        turns an exception in an SNES callback into a ``PETSc.Error`` (3.18 passes it on as
+        it is), and ``SNESSolver.solve`` re-raises the original."""
+        try:
+            self._residual(x, b)
+        except Exception as exc:
+            self.callback_error = exc
+            raise
+
+    def _residual(self, x: PETSc.Vec, b: PETSc.Vec) -> None:
         self.update_solution(x)
         t0 = MPI.Wtime()
         self.K.mult(x, b)
@@ -482,7 +494,15 @@ class ContactProblem:
 
         The interface part is that of the last residual evaluation: SNES always evaluates the
         residual at an iterate before its Jacobian (its line searches end with the residual
-        at the accepted iterate), so the law runs once per Newton iteration."""
+        at the accepted iterate), so the law runs once per Newton iteration. Exceptions: see
+        :meth:`F`."""
+        try:
+            self._jacobian(x, A, P)
+        except Exception as exc:
+            self.callback_error = exc
+            raise
+
+    def _jacobian(self, x: PETSc.Vec, A: PETSc.Mat, P: PETSc.Mat) -> None:
         self.update_solution(x)
         t0 = MPI.Wtime()
         self.K.copy(A, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)

@@ -321,9 +321,17 @@ class SNESSolver:
                 atol_before = atol_now
                 self.snes.setTolerances(atol=atol)
         # Some options are read only when the preconditioner is set up, inside the solve.
+        self.problem.callback_error = None
         try:
             with self._options():
                 self.snes.solve(None, self.x)
+        except PETSc.Error:
+            # petsc4py >= 3.20 wraps an exception of our callbacks in a PETSc.Error: give the
+            # caller the original (a ConvergenceError to cut back on, a user's TypeError, ...)
+            if self.problem.callback_error is not None:
+                self._fresh_vectors()
+                raise self.problem.callback_error from None
+            raise
         finally:
             if atol_before is not None:
                 self.snes.setTolerances(atol=atol_before)
@@ -333,6 +341,17 @@ class SNESSolver:
         ok = reason > 0 and all(np.isfinite(res))
         return SolveResult(ok, int(reason), _reason_name(reason), self.snes.getIterationNumber(),
                            res, self.snes.getLinearSolveIterations())
+
+    def _fresh_vectors(self) -> None:
+        """After a callback's exception petsc4py >= 3.20 leaves the vectors the line search had
+        locked read-only locked (petsc4py has no call to unlock them): the SNES drops its work
+        vectors and gets a new solution and residual vector."""
+        self.snes.reset()
+        self.x = self.x.duplicate()
+        self.problem.b = self.problem.b.duplicate()
+        self.snes.setFunction(self.problem.F, self.problem.b)
+        self.snes.setJacobian(self.problem.J, self.problem.A)
+        self._A = self.problem.A
 
     def report_unused_options(self) -> list[str]:
         """Warn (rank 0) about options under this solver's prefix that PETSc never read.
