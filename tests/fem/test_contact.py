@@ -285,6 +285,21 @@ def test_uniform_jump_patch():
     assert st.n_slipping == 0 and st.slipping_area == 0.0 and st.dissipation == 0.0
 
 
+def _coulomb_assembled(V, tags, bcs=()):
+    """A softplus Coulomb interface between the blocks (with ``bcs``), its residual and its
+    assembled Jacobian (in the bulk pattern) at a smooth field: (interface, b, A)."""
+    law = SoftplusPenalty(1e4, 1e-3, k_tangential=5e3, friction=0.3)
+    ci = ContactInterface(V, tags, LOWER_TOP, UPPER_BOTTOM, law=law, bcs=bcs)
+    u = fem.Function(V)
+    interpolate_bodies(u, lambda x, up: smooth_field(x, up, 2e-3))
+    b = residual(ci, V, u)
+    A = ci.create_matrix(fem.form(ufl.inner(ufl.TrialFunction(V), ufl.TestFunction(V)) * ufl.dx))
+    ci.evaluate(u)
+    ci.assemble_jacobian(A)
+    A.assemble()
+    return ci, b, A
+
+
 def _global_figures(comm, degree, patch):
     msh, tags = two_blocks(comm, n=(4, 3, 1))
     if patch:  # keep only a small patch of the interface tagged: most ranks own none of it
@@ -295,15 +310,7 @@ def _global_figures(comm, degree, patch):
         ).astype(np.int32)
         tags = dmesh.meshtags(msh, 2, tags.indices, vals)
     V = fem.VectorFunctionSpace(msh, ("Lagrange", degree))
-    law = SoftplusPenalty(1e4, 1e-3, k_tangential=5e3, friction=0.3)
-    ci = ContactInterface(V, tags, LOWER_TOP, UPPER_BOTTOM, law=law)
-    u = fem.Function(V)
-    interpolate_bodies(u, lambda x, up: smooth_field(x, up, 2e-3))
-    b = residual(ci, V, u)
-    A = ci.create_matrix(fem.form(ufl.inner(ufl.TrialFunction(V), ufl.TestFunction(V)) * ufl.dx))
-    ci.evaluate(u)
-    ci.assemble_jacobian(A)
-    A.assemble()
+    ci, b, A = _coulomb_assembled(V, tags)
     ci.commit()
     st = ci.summary()
     return (
@@ -556,15 +563,7 @@ def test_dirichlet_dofs_are_skipped(degree):
     V0, _ = V.sub(0).collapse()
     dofs = fem.locate_dofs_topological((V.sub(0), V0), fdim, side)
     bc = fem.dirichletbc(fem.Function(V0), dofs, V.sub(0))
-    law = SoftplusPenalty(1e4, 1e-3, k_tangential=5e3, friction=0.3)
-    ci = ContactInterface(V, tags, LOWER_TOP, UPPER_BOTTOM, law=law, bcs=[bc])
-    u = fem.Function(V)
-    interpolate_bodies(u, lambda x, up: smooth_field(x, up, 2e-3))
-    b = residual(ci, V, u)
-    A = ci.create_matrix(fem.form(ufl.inner(ufl.TrialFunction(V), ufl.TestFunction(V)) * ufl.dx))
-    ci.evaluate(u)
-    ci.assemble_jacobian(A)
-    A.assemble()
+    ci, b, A = _coulomb_assembled(V, tags, bcs=[bc])
     # owned bc DOFs as global scalar indices
     local = np.asarray(bc.dof_indices()[0])
     local = local[local < 3 * V.dofmap.index_map.size_local]
