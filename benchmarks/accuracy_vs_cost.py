@@ -198,6 +198,35 @@ def _bin_pressure(comm, interface, edges_x, edges_y, coord=(0, 1), modes=None):
     return (force / area).ravel(), g_centre, coeffs
 
 
+class _Path:
+    """The increments of a load path (iterate over it), counting the Newton iterations and the
+    largest relative force-balance error |Fz_contact + Fz_applied| / |Fz_applied|."""
+
+    def __init__(self, problem, solver, factors):
+        self.problem, self.solver, self.factors = problem, solver, factors
+        self.newton, self.max_force_error = 0, 0.0
+
+    def __iter__(self):
+        for inc in load_path(self.problem, self.solver, self.factors, verbose=False):
+            self.newton += inc.iterations
+            self.max_force_error = max(self.max_force_error,
+                                       abs(inc.contact_force[2] + inc.applied_force[2])
+                                       / abs(inc.applied_force[2]))
+            yield inc
+
+    def result(self, comm, interface, times, **figures):
+        """One run's row: ``figures``, sizes, Newton, force error and times (``times`` = (start,
+        start of the solve, mesh, law) [s]); destroys the solver. Collective."""
+        t0, t1, t_mesh, t_law = times
+        res = dict(figures, num_dofs=self.problem.num_dofs, n_points=interface.n_points_global,
+                   newton=self.newton, max_force_error=self.max_force_error, t_mesh=t_mesh,
+                   t_law=t_law, t_solve=time.perf_counter() - t1)
+        self.solver.destroy()
+        comm.Barrier()
+        res["wall_time"] = time.perf_counter() - t0 + t_law
+        return res
+
+
 # ## The punch
 def run_punch(comm, mesh, order, quadrature, steps, rtol, kind):
     """One punch run (quarter model, case b, load to 1000 N, unload). Collective."""
@@ -221,28 +250,18 @@ def run_punch(comm, mesh, order, quadrature, steps, rtol, kind):
         fem.Constant(scene.mesh, PETSc.ScalarType(1.0)) * load_ds)), op=MPI.SUM)
     edges = np.linspace(0.0, a, PUNCH_BINS + 1)
     out = {}
-    newton = 0
-    max_err = 0.0
-    for inc in load_path(problem, solver, load_unload_factors(steps, steps - 1), verbose=False):
-        newton += inc.iterations
-        max_err = max(max_err, abs(inc.contact_force[2] + inc.applied_force[2])
-                      / abs(inc.applied_force[2]))
+    path = _Path(problem, solver, load_unload_factors(steps, steps - 1))
+    for inc in path:
         if inc.load_factor == 1.0 and inc.target == 1.0:
             uz = comm.allreduce(fem.assemble_scalar(uz_form), op=MPI.SUM) / area_load
             bins, g_c, modes = _bin_pressure(comm, interface, edges, edges,
                                              modes=(a, a, (PUNCH_MODES, PUNCH_MODES)))
             out.update(approach=-uz, bins=bins, g_centre=g_c, modes=modes)
     D = interface.dissipation()
-    res = dict(approach=out["approach"], g_centre=comm.bcast(out["g_centre"], root=0),
-               dissipation=D, bins=comm.bcast(out["bins"], root=0),
-               modes=comm.bcast(out["modes"], root=0),
-               num_dofs=problem.num_dofs, n_points=interface.n_points_global, newton=newton,
-               max_force_error=max_err, t_mesh=t_mesh, t_law=t_law,
-               t_solve=time.perf_counter() - t1)
-    solver.destroy()
-    comm.Barrier()
-    res["wall_time"] = time.perf_counter() - t0 + t_law
-    return res
+    return path.result(comm, interface, (t0, t1, t_mesh, t_law), approach=out["approach"],
+                       g_centre=comm.bcast(out["g_centre"], root=0), dissipation=D,
+                       bins=comm.bcast(out["bins"], root=0),
+                       modes=comm.bcast(out["modes"], root=0))
 
 
 # ## The beam
@@ -260,12 +279,8 @@ def run_beam(comm, mesh, order, quadrature, steps, rtol, kind):
                                 prefix="rc_", dof_threshold=200_000, quadrature_degree=quadrature)
     problem, solver, interface, factors = case.problem, case.solver, case.interface, case.factors
     uz0 = None
-    newton = 0
-    max_err = 0.0
-    for inc in load_path(problem, solver, factors, verbose=False):
-        newton += inc.iterations
-        max_err = max(max_err, abs(inc.contact_force[2] + inc.applied_force[2])
-                      / abs(inc.applied_force[2]))
+    path = _Path(problem, solver, factors)
+    for inc in path:
         if uz0 is None:
             uz0 = beam_demo.contact_uz(setup, problem.u)
     prof = beam_demo.deflection_profile(comm, setup, beam_demo.contact_uz(setup, problem.u) - uz0)
@@ -273,15 +288,9 @@ def run_beam(comm, mesh, order, quadrature, steps, rtol, kind):
     edges_x = np.array([-dims["width"] / 2 - 1.0, dims["width"] / 2 + 1.0])
     bins, _, modes = _bin_pressure(comm, interface, edges_x, edges_y,
                                    modes=(dims["width"], dims["half_length"], (1, BEAM_MODES)))
-    res = dict(uN_centre=prof.centre, uN_end=prof.end, bins=comm.bcast(bins, root=0),
-               modes=comm.bcast(modes, root=0),
-               num_dofs=problem.num_dofs, n_points=interface.n_points_global, newton=newton,
-               max_force_error=max_err, t_mesh=t_mesh, t_law=t_law,
-               t_solve=time.perf_counter() - t1)
-    solver.destroy()
-    comm.Barrier()
-    res["wall_time"] = time.perf_counter() - t0 + t_law
-    return res
+    return path.result(comm, interface, (t0, t1, t_mesh, t_law), uN_centre=prof.centre,
+                       uN_end=prof.end, bins=comm.bcast(bins, root=0),
+                       modes=comm.bcast(modes, root=0))
 
 
 # ## Plan, CSV, report

@@ -16,7 +16,6 @@ Units: mm, MPa; ppw = pixels per shortest wavelength 2 pi/q_s of the spectrum.
 from __future__ import annotations
 
 import argparse
-import csv
 import math
 import os
 import sys
@@ -24,6 +23,7 @@ import time
 import warnings
 
 import numpy as np
+from _common import write_csv
 
 from rough_contact.micro import bem
 from rough_contact.surface.spectrum import _next_smooth, example_surfaces, fit_spectrum
@@ -149,11 +149,7 @@ def main(argv=None):
             else "not reached below the finest grid"
         print(f"{name}: p(h) and k(h) within 1 % of the finest grid from {need}")
     if args.csv:
-        os.makedirs(os.path.dirname(args.csv) or ".", exist_ok=True)
-        with open(args.csv, "w", newline="") as f:
-            w = csv.DictWriter(f, fieldnames=list(rows[0]))
-            w.writeheader()
-            w.writerows(rows)
+        write_csv(args.csv, rows)
     if args.figure:
         os.makedirs(os.path.dirname(args.figure) or ".", exist_ok=True)
         figure(rows, args.figure)

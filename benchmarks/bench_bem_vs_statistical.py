@@ -18,10 +18,10 @@ docs/figures/bem_compare_<surface>.png per surface.
 from __future__ import annotations
 
 import argparse
-import csv
 import os
 
 import numpy as np
+from _common import write_csv
 
 from rough_contact.micro import law_comparison as compare_laws
 from rough_contact.surface.spectrum import example_surfaces
@@ -161,11 +161,7 @@ def main(argv=None):
             print(f"    {name:28s} k(p): {txt['k_at_p']:>13s}  A(p): {txt['a_at_p']:>13s}  "
                   f"p(h): {txt['p_at_h']:>13s}  all: {txt['all']:>13s}")
     if args.csv:
-        os.makedirs(os.path.dirname(args.csv) or ".", exist_ok=True)
-        with open(args.csv, "w", newline="") as f:
-            w = csv.DictWriter(f, fieldnames=list(all_rows[0]))
-            w.writeheader()
-            w.writerows(all_rows)
+        write_csv(args.csv, all_rows)
     if args.figdir:
         figure(results, os.path.join(args.figdir, "bem_vs_statistical.png"))
         print(f"figures: {args.figdir}/bem_vs_statistical.png, bem_compare_<surface>.png")

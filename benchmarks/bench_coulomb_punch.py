@@ -20,11 +20,11 @@ Units: mm, N, MPa.
 from __future__ import annotations
 
 import argparse
-import csv
 import sys
 import time
 
 import petsc4py
+from _common import write_csv
 
 petsc4py.init(sys.argv)   # -rc_* options reach PETSc (before dolfinx is imported)
 
@@ -117,10 +117,7 @@ def main(argv=None):
                         f"{r['max_its']:7d} {r['cpu']:7.1f} {r['D_peak']:10.4e} "
                         f"{r['D_end']:10.4e} {r['slip_peak']:5.2f}")
     if args.csv and MPI.COMM_WORLD.rank == 0:
-        with open(args.csv, "w", newline="") as f:
-            w = csv.DictWriter(f, fieldnames=list(rows[0]))
-            w.writeheader()
-            w.writerows(rows)
+        write_csv(args.csv, rows)
     return rows
 
 

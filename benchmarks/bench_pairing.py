@@ -100,63 +100,76 @@ def accuracy():
             f"{e:10.2e} {n:6d}" for e, n in row))
 
 
+def _meshes(points):
+    """(target points, label, elements per side of the lower and of the upper block) of the
+    cost and Newton tables: equal meshes, and 5:7."""
+    for n_target in points:
+        n_side = int(round(np.sqrt(n_target / 4.0)))
+        for label, n_up in (("equal", n_side), ("5:7", int(round(n_side * 7 / 5)))):
+            yield n_target, label, n_side, n_up
+
+
+def _coulomb_interface(V, scene, pairing, bcs=()):
+    """The rough-free Coulomb penalty interface of the tables; ``pairing`` "moderate" is the
+    projection pairing with ``sliding="moderate"`` (re-paired on the deformed surfaces)."""
+    law = SoftplusPenalty(1e6, 1e-6, k_tangential=1e6, friction=0.3)
+    return ContactInterface(V, scene.facet_tags, *scene.contact_pair, law=law, bcs=bcs,
+                            pairing="projection" if pairing == "moderate" else pairing,
+                            sliding="moderate" if pairing == "moderate" else "small")
+
+
 def cost(points, only=None):
     PETSc.Sys.Print("\ncost (serial, Q1 hexahedra, 4 points per first facet, Coulomb penalty)")
     PETSc.Sys.Print(f"{'target':>7} {'meshes':>9} {'pairing':>10} {'points':>8} {'groups':>7} "
                     f"{'set-up s':>8} {'R+J s':>7} {'bulk J s':>8} {'R+J/bulk':>8} "
                     f"{'re-pair s':>9}")
-    for n_target in points:
-        n_side = int(round(np.sqrt(n_target / 4.0)))
-        for label, n_up in (("equal", n_side), ("5:7", int(round(n_side * 7 / 5)))):
-            scene = separate_blocks(h1=1.0 / n_side, h2=1.0 / n_side, size_lower=1.0 / n_side,
-                                    size_upper=1.0 / n_up, cell_type="hexahedron")
-            V = compat.vector_space(scene.mesh, 1)
-            u = fem.Function(V)
-            u.interpolate(lambda x: 1e-4 * np.stack([np.sin(x[0]), np.cos(x[1]), x[2] - 0.5]))
-            du, v = ufl.TrialFunction(V), ufl.TestFunction(V)
-            eps = ufl.sym(ufl.grad(du))
-            lmbda, mu = E * NU / ((1 + NU) * (1 - 2 * NU)), E / (2 * (1 + NU))
-            a = fem.form(ufl.inner(2 * mu * eps + lmbda * ufl.tr(eps) * ufl.Identity(3),
-                                   ufl.sym(ufl.grad(v))) * ufl.dx)
-            pairings = ["conforming", "projection", "mortar", "moderate"] if label == "equal" \
-                else ["projection", "mortar", "moderate"]
-            for pairing in [p for p in pairings if only is None or p in only]:
-                law = SoftplusPenalty(1e6, 1e-6, k_tangential=1e6, friction=0.3)
+    for n_target, label, n_side, n_up in _meshes(points):
+        scene = separate_blocks(h1=1.0 / n_side, h2=1.0 / n_side, size_lower=1.0 / n_side,
+                                size_upper=1.0 / n_up, cell_type="hexahedron")
+        V = compat.vector_space(scene.mesh, 1)
+        u = fem.Function(V)
+        u.interpolate(lambda x: 1e-4 * np.stack([np.sin(x[0]), np.cos(x[1]), x[2] - 0.5]))
+        du, v = ufl.TrialFunction(V), ufl.TestFunction(V)
+        eps = ufl.sym(ufl.grad(du))
+        lmbda, mu = E * NU / ((1 + NU) * (1 - 2 * NU)), E / (2 * (1 + NU))
+        a = fem.form(ufl.inner(2 * mu * eps + lmbda * ufl.tr(eps) * ufl.Identity(3),
+                               ufl.sym(ufl.grad(v))) * ufl.dx)
+        pairings = ["conforming", "projection", "mortar", "moderate"] if label == "equal" \
+            else ["projection", "mortar", "moderate"]
+        for pairing in [p for p in pairings if only is None or p in only]:
+            t0 = time.perf_counter()
+            ci = _coulomb_interface(V, scene, pairing)
+            t_setup = time.perf_counter() - t0
+            A = ci.create_matrix(a)
+            b = compat.create_petsc_vector(V)
+            t0 = time.perf_counter()
+            A.zeroEntries()
+            dolfinx.fem.petsc.assemble_matrix(A, a)
+            t_bulk = time.perf_counter() - t0
+            times = []
+            for k in range(3):      # a new u each time: the law is evaluated every time
+                u.x.array[:] *= 1.0 + 1e-3
+                u.x.scatter_forward()
                 t0 = time.perf_counter()
-                ci = ContactInterface(V, scene.facet_tags, *scene.contact_pair, law=law,
-                                      pairing="projection" if pairing == "moderate" else pairing,
-                                      sliding="moderate" if pairing == "moderate" else "small")
-                t_setup = time.perf_counter() - t0
-                A = ci.create_matrix(a)
-                b = compat.create_petsc_vector(V)
-                t0 = time.perf_counter()
-                A.zeroEntries()
-                dolfinx.fem.petsc.assemble_matrix(A, a)
-                t_bulk = time.perf_counter() - t0
-                times = []
-                for k in range(3):      # a new u each time: the law is evaluated every time
-                    u.x.array[:] *= 1.0 + 1e-3
-                    u.x.scatter_forward()
-                    t0 = time.perf_counter()
-                    b.set(0.0)
-                    ci.evaluate(u)
-                    ci.assemble_residual(b)
-                    ci.evaluate(u)
-                    ci.assemble_jacobian(A)
-                    times.append(time.perf_counter() - t0)
-                A.assemble()
-                t_if = min(times)
-                t_re = float("nan")
-                if pairing == "moderate":   # sliding = 'moderate': projection on the deformed
-                    t0 = time.perf_counter()  # surfaces, new operator and scatter
-                    ci.commit()       # a converged increment: the next one re-pairs
-                    ci.begin_increment(u)
-                    t_re = time.perf_counter() - t0
-                PETSc.Sys.Print(f"{n_target:7d} {label:>9} {pairing:>10} {ci.n_points_global:8d} "
-                                f"{ci.n_groups:7d} {t_setup:8.2f} {t_if:7.3f} {t_bulk:8.3f} "
-                                f"{t_if / t_bulk:8.2f} {t_re:9.2f}")
-                A.destroy()
-                b.destroy()
+                b.set(0.0)
+                ci.evaluate(u)
+                ci.assemble_residual(b)
+                ci.evaluate(u)
+                ci.assemble_jacobian(A)
+                times.append(time.perf_counter() - t0)
+            A.assemble()
+            t_if = min(times)
+            t_re = float("nan")
+            if pairing == "moderate":   # sliding = 'moderate': projection on the deformed
+                t0 = time.perf_counter()  # surfaces, new operator and scatter
+                ci.commit()       # a converged increment: the next one re-pairs
+                ci.begin_increment(u)
+                t_re = time.perf_counter() - t0
+            PETSc.Sys.Print(f"{n_target:7d} {label:>9} {pairing:>10} {ci.n_points_global:8d} "
+                            f"{ci.n_groups:7d} {t_setup:8.2f} {t_if:7.3f} {t_bulk:8.3f} "
+                            f"{t_if / t_bulk:8.2f} {t_re:9.2f}")
+            A.destroy()
+            b.destroy()
 
 
 def newton(points, only=None):
@@ -168,47 +181,41 @@ def newton(points, only=None):
     PETSc.Sys.Print(f"{'target':>7} {'meshes':>6} {'pairing':>10} {'points':>8} {'DOFs':>8} "
                     f"{'Newton':>6} {'total s':>7} {'bulk s':>7} {'iface s':>7} {'share':>6} "
                     f"{'re-pair s':>9} {'solver':>14}")
-    for n_target in points:
-        n_side = int(round(np.sqrt(n_target / 4.0)))
-        for label, n_up in (("equal", n_side), ("5:7", int(round(n_side * 7 / 5)))):
-            for pairing in [p for p in ("projection", "mortar", "moderate")
-                            if only is None or p in only]:
-                scene = separate_blocks(h1=0.25, h2=0.25, size_lower=1.0 / n_side,
-                                        size_upper=1.0 / n_up, cell_type="hexahedron")
-                V = compat.vector_space(scene.mesh, 1)
-                bcs = [_roller(V, scene, "x0", 0), _roller(V, scene, "y0", 1),
-                       _roller(V, scene, "bottom", 2)]
-                law = SoftplusPenalty(1e6, 1e-6, k_tangential=1e6, friction=0.3)
-                ci = ContactInterface(V, scene.facet_tags, *scene.contact_pair, law=law,
-                                      bcs=bcs, pairing="projection" if pairing == "moderate"
-                                      else pairing,
-                                      sliding="moderate" if pairing == "moderate" else "small")
-                mats = {scene.tag("upper"): Material(E, NU),
-                        scene.tag("lower"): Material(0.5 * E, NU)}
-                problem = ContactProblem(V, mats, bcs, [SurfaceLoad(scene.tag("top"),
-                                                                    traction=[0, 0, -P])],
-                                         cell_tags=scene.cell_tags,
-                                         facet_tags=scene.facet_tags, interface=ci)
-                solver = SNESSolver(problem, prefix="bench_newton_")
-                problem.set_load_factor(1.0)
-                problem.reset_timings()
+    for n_target, label, n_side, n_up in _meshes(points):
+        for pairing in [p for p in ("projection", "mortar", "moderate")
+                        if only is None or p in only]:
+            scene = separate_blocks(h1=0.25, h2=0.25, size_lower=1.0 / n_side,
+                                    size_upper=1.0 / n_up, cell_type="hexahedron")
+            V = compat.vector_space(scene.mesh, 1)
+            bcs = [_roller(V, scene, "x0", 0), _roller(V, scene, "y0", 1),
+                   _roller(V, scene, "bottom", 2)]
+            ci = _coulomb_interface(V, scene, pairing, bcs)
+            mats = {scene.tag("upper"): Material(E, NU),
+                    scene.tag("lower"): Material(0.5 * E, NU)}
+            problem = ContactProblem(V, mats, bcs, [SurfaceLoad(scene.tag("top"),
+                                                                traction=[0, 0, -P])],
+                                     cell_tags=scene.cell_tags,
+                                     facet_tags=scene.facet_tags, interface=ci)
+            solver = SNESSolver(problem, prefix="bench_newton_")
+            problem.set_load_factor(1.0)
+            problem.reset_timings()
+            t0 = MPI.Wtime()
+            result = solver.solve()
+            total = MPI.Wtime() - t0
+            t = problem.timings
+            iface = t["interface_residual"] + t["interface_jacobian"]
+            t_re = float("nan")
+            if pairing == "moderate":
                 t0 = MPI.Wtime()
-                result = solver.solve()
-                total = MPI.Wtime() - t0
-                t = problem.timings
-                iface = t["interface_residual"] + t["interface_jacobian"]
-                t_re = float("nan")
-                if pairing == "moderate":
-                    t0 = MPI.Wtime()
-                    ci.commit()
-                    problem.begin_increment()
-                    t_re = MPI.Wtime() - t0
-                PETSc.Sys.Print(f"{n_target:7d} {label:>6} {pairing:>10} "
-                                f"{ci.n_points_global:8d} {problem.num_dofs:8d} "
-                                f"{result.iterations:6d} {total:7.2f} {t['bulk']:7.2f} "
-                                f"{iface:7.2f} {iface / total:6.1%} {t_re:9.2f} "
-                                f"{solver.linear_solver:>14}")
-                solver.destroy()
+                ci.commit()
+                problem.begin_increment()
+                t_re = MPI.Wtime() - t0
+            PETSc.Sys.Print(f"{n_target:7d} {label:>6} {pairing:>10} "
+                            f"{ci.n_points_global:8d} {problem.num_dofs:8d} "
+                            f"{result.iterations:6d} {total:7.2f} {t['bulk']:7.2f} "
+                            f"{iface:7.2f} {iface / total:6.1%} {t_re:9.2f} "
+                            f"{solver.linear_solver:>14}")
+            solver.destroy()
 
 
 def main(argv=None):

@@ -48,7 +48,6 @@ import argparse  # noqa: E402
 import json  # noqa: E402
 import os  # noqa: E402
 import shutil  # noqa: E402
-import signal  # noqa: E402
 import subprocess  # noqa: E402
 import tempfile  # noqa: E402
 import time  # noqa: E402
@@ -375,10 +374,12 @@ def extract_hertz(r):
 KILL_AFTER = 7          # one of the test's three kill points (3, 7, 12)
 
 
-def _worker_cmd(mode, directory, out):
-    worker = ROOT / "tests" / "demos" / "checkpoint_worker.py"
-    return [shutil.which("mpirun"), "-n", "2", sys.executable, str(worker), mode,
-            str(directory), str(out)]
+def _kill_rank():
+    """tests/demos/kill_rank.py: the worker's command and the run killed at a step."""
+    sys.path.insert(0, str(ROOT / "tests" / "demos"))
+    import kill_rank
+
+    return kill_rank
 
 
 def _worker_env():
@@ -399,10 +400,11 @@ def run_restart_after_kill(comm):
         return dict(skipped="mpirun not found")
     tmp = Path(tempfile.mkdtemp(prefix="rc_regression_kill_"))
     env = _worker_env()
+    kill_rank = _kill_rank()
 
     def run(mode, directory, out):
-        proc = subprocess.run(_worker_cmd(mode, directory, out), env=env, capture_output=True,
-                              text=True, timeout=600)
+        proc = subprocess.run(kill_rank.worker_cmd(mode, directory, out), env=env,
+                              capture_output=True, text=True, timeout=600)
         if proc.returncode != 0:
             raise RuntimeError(f"checkpoint_worker {mode} failed:\n{proc.stdout[-2000:]}\n"
                                f"{proc.stderr[-2000:]}")
@@ -410,17 +412,7 @@ def run_restart_after_kill(comm):
 
     reference = run("full", tmp / "unused", tmp / "full.json")
     directory = tmp / f"ckpt_{KILL_AFTER}"
-    proc = subprocess.Popen(_worker_cmd("checkpointed", directory, tmp / "never.json"), env=env,
-                            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
-    pids, killed = {}, False
-    for line in proc.stdout:
-        parts = line.split()
-        if parts[:1] == ["PIDS"]:
-            pids = {rank: int(p) for rank, p in enumerate(parts[1:])}
-        elif parts[:1] == ["STEP"] and int(parts[1]) >= KILL_AFTER and not killed:
-            os.kill(pids[1], signal.SIGKILL)
-            killed = True
-    proc.wait(timeout=120)
+    proc, killed = kill_rank.kill_checkpointed_run(directory, tmp / "never.json", env, KILL_AFTER)
     resumed = run("resume", directory, tmp / "resumed.json")
     shutil.rmtree(tmp, ignore_errors=True)
     return dict(reference=reference, resumed=resumed, killed=killed,

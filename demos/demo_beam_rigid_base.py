@@ -48,7 +48,8 @@
 from __future__ import annotations
 
 import argparse
-import sys
+
+from _common import DOF_THRESHOLD_HELP, parse_known, start
 
 TABLE4_CASES = [1, 2, 3, 4, 5, 6]  # m00 = 0.625, 0.3125, 0.0625 um^2; elastic, elasto-plastic
 
@@ -83,36 +84,19 @@ def parse_args(argv):
     parser.add_argument("--figdir", default=None, help="also copy the figures here "
                         "(e.g. docs/figures)")
     parser.add_argument("--fig-suffix", default="", help="appended to the figure file names")
-    parser.add_argument("--dof-threshold", type=int, default=None,
-                        help="above this many DOFs the default linear solver is AMG-preconditioned "
-                        "GMRES, else MUMPS (default: the solver's measured threshold, "
-                        "docs/solver.md; -rc_linear_solver mumps|gamg|hypre picks one outright)")
+    parser.add_argument("--dof-threshold", type=int, default=None, help=DOF_THRESHOLD_HELP)
     parser.add_argument("--no-xdmf", action="store_true", help="write no XDMF/point clouds")
-    args, rest = parser.parse_known_args(argv)
-    # PETSc options have one dash; a double-dash leftover is a mistyped option of this script.
-    bad = [a for a in rest if a.startswith("--")]
-    if bad:
-        parser.error(f"unrecognized arguments: {' '.join(bad)}")
-    return args, rest
+    return parse_known(parser, argv)
 
-
-import petsc4py  # noqa: E402
-
-# PETSc must see its command-line options before dolfinx is imported (the library imports it).
-if __name__ == "__main__":
-    ARGS, PETSC_ARGS = parse_args(sys.argv[1:])
-    petsc4py.init([sys.argv[0]] + PETSC_ARGS)
-
-# The scene, laws, set-up, deflection extraction and figures live in the library
-# (rough_contact/scenes/beam.py): build_scene -> BeamScene, build_case -> BeamCase,
-# run_case (one Table 4 case), run (the chosen cases, the table and the figures).
-from rough_contact.scenes.beam import run  # noqa: E402
 
 if __name__ == "__main__":
-    from rough_contact.solver.parallel import abort_on_uncaught_exception
+    # PETSc must see its command-line options before dolfinx is imported (the library imports it)
+    args = start(parse_args)
+    # The scene, laws, set-up, deflection extraction and figures live in the library
+    # (rough_contact/scenes/beam.py): build_scene -> BeamScene, build_case -> BeamCase,
+    # run_case (one Table 4 case), run (the chosen cases, the table and the figures).
+    from rough_contact.scenes.beam import run
 
-    abort_on_uncaught_exception()  # one failing rank must not leave the others waiting
-    args = ARGS
     run(cases=args.cases, mesh_size=args.mesh_size, contact_size=args.contact_size,
         order=args.order, load_half_length=args.load_half_length, steps=args.steps,
         tangential=args.tangential, friction=args.friction, hardness=args.hardness,

@@ -127,10 +127,11 @@ def solve_with_own_newton(comm, n, rtol=1e-10, max_it=30):
         problem.set_load_factor(lam)
         x = problem.solution_vector().copy()
         dx = x.duplicate()
+        norm0 = None
         for it in range(max_it):
             problem.F(None, x, problem.b)         # evaluates the interface at x
             norm = problem.b.norm()
-            norm0 = norm if it == 0 else norm0
+            norm0 = norm if norm0 is None else norm0
             if norm <= rtol * norm0:
                 break
             problem.J(None, x, problem.A, problem.A)

@@ -43,7 +43,8 @@
 from __future__ import annotations
 
 import argparse
-import sys
+
+from _common import DOF_THRESHOLD_HELP, parse_known, start
 
 
 def parse_args(argv):
@@ -79,36 +80,19 @@ def parse_args(argv):
     parser.add_argument("--validity", default="warn", choices=["warn", "error", "ignore"],
                         help="interface points beyond the normal law's validity in a converged "
                              "increment: warn (default), stop with an error, or only count them")
-    parser.add_argument("--dof-threshold", type=int, default=None,
-                        help="above this many DOFs the default linear solver is AMG-preconditioned "
-                        "GMRES, else MUMPS (default: the solver's measured threshold, "
-                        "docs/solver.md; -rc_linear_solver mumps|gamg|hypre picks one outright)")
-    args, rest = parser.parse_known_args(argv)
-    # PETSc options have one dash; a double-dash leftover is a mistyped option of this script.
-    bad = [a for a in rest if a.startswith("--")]
-    if bad:
-        parser.error(f"unrecognized arguments: {' '.join(bad)}")
-    return args, rest
+    parser.add_argument("--dof-threshold", type=int, default=None, help=DOF_THRESHOLD_HELP)
+    return parse_known(parser, argv)
 
-
-import petsc4py  # noqa: E402
-
-# PETSc must see its command-line options before dolfinx is imported (the library imports it).
-if __name__ == "__main__":
-    ARGS, PETSC_ARGS = parse_args(sys.argv[1:])
-    petsc4py.init([sys.argv[0]] + PETSC_ARGS)
-
-# The scene, its laws, the set-up and the load stepping live in the library
-# (rough_contact/scenes/flat_punch.py reads top to bottom as what is solved):
-#   build(...) -> PunchModel(scene, V, law, normal, interface, problem, solver)
-#   run(...)   -> load path 1000 N in `steps` increments and back, output, force-balance check
-from rough_contact.scenes.flat_punch import run  # noqa: E402
 
 if __name__ == "__main__":
-    from rough_contact.solver.parallel import abort_on_uncaught_exception
+    # PETSc must see its command-line options before dolfinx is imported (the library imports it)
+    args = start(parse_args)
+    # The scene, its laws, the set-up and the load stepping live in the library
+    # (rough_contact/scenes/flat_punch.py reads top to bottom as what is solved):
+    #   build(...) -> PunchModel(scene, V, law, normal, interface, problem, solver)
+    #   run(...)   -> load path 1000 N in `steps` increments and back, output, force-balance check
+    from rough_contact.scenes.flat_punch import run
 
-    abort_on_uncaught_exception()  # one failing rank must not leave the others waiting
-    args = ARGS
     run(mesh_size=args.mesh_size, contact_size=args.contact_size, order=args.order,
         load_half_width=args.load_half_width, steps=args.steps, unload=not args.no_unload,
         law=args.law, case=args.case, normal_law=args.normal_law, outdir=args.outdir,

@@ -14,6 +14,7 @@ import argparse
 import sys
 
 import petsc4py
+from _common import parse_known
 
 
 def main(argv=None):
@@ -33,10 +34,7 @@ def main(argv=None):
     ck.add_argument("--restart", default=None, metavar="CKDIR",
                     help="continue a stopped run (same options and ranks) from CKDIR: finished "
                     "amplitudes are read back, the interrupted one continues")
-    args, rest = ap.parse_known_args(sys.argv[1:] if argv is None else argv)
-    bad = [a for a in rest if a.startswith("--")]
-    if bad:
-        ap.error(f"unrecognized arguments: {' '.join(bad)}")
+    args, rest = parse_known(ap, sys.argv[1:] if argv is None else argv)
     # PETSc options (one dash, prefix fret_, e.g. -fret_linear_solver mumps_lagged) must reach
     # PETSc before dolfinx is imported
     # Default: MUMPS factors lagged over 3 Newton iterations with GMRES on top — half the time

@@ -31,7 +31,8 @@
 from __future__ import annotations
 
 import argparse
-import sys
+
+from _common import parse_known, start
 
 
 def parse_args(argv):
@@ -51,26 +52,13 @@ def parse_args(argv):
                     help="BEM backend (default: tamaas, rough_contact.micro.bem)")
     ap.add_argument("--small", action="store_true", help="test size (< 1 min)")
     ap.add_argument("--outdir", default="results/punch_bem_vs_statistical")
-    args, rest = ap.parse_known_args(argv)
-    bad = [a for a in rest if a.startswith("--")]
-    if bad:
-        ap.error(f"unrecognized arguments: {' '.join(bad)}")
-    return args, rest
+    return parse_known(ap, argv)
 
-
-import petsc4py  # noqa: E402
 
 if __name__ == "__main__":
-    ARGS, PETSC_ARGS = parse_args(sys.argv[1:])
-    petsc4py.init([sys.argv[0]] + PETSC_ARGS)
+    a = start(parse_args)      # PETSc's options in before the library imports dolfinx
+    from rough_contact.scenes.punch_bem import run
 
-from rough_contact.scenes.punch_bem import run  # noqa: E402
-
-if __name__ == "__main__":
-    from rough_contact.solver.parallel import abort_on_uncaught_exception
-
-    abort_on_uncaught_exception()
-    a = ARGS
     run(surface=a.surface, force=a.force, steps=a.steps, case=a.case, mesh_size=a.mesh_size,
         contact_size=a.contact_size, order=a.order, realisations=a.realisations, ppw=a.ppw,
         small=a.small, backend=a.backend, outdir=a.outdir)

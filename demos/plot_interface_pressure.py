@@ -28,6 +28,8 @@ import argparse
 import os
 import sys
 
+from _common import parse_known
+
 
 def parse_args(argv):
     parser = argparse.ArgumentParser(description="Draw the interface pressure of an "
@@ -49,11 +51,7 @@ def parse_args(argv):
     parser.add_argument("--contact-size", type=float, default=1.0)
     parser.add_argument("--order", type=int, default=2, choices=[1, 2])
     parser.add_argument("--steps", type=int, default=8, help="loading increments of --run")
-    args, rest = parser.parse_known_args(argv)
-    bad = [a for a in rest if a.startswith("--")]
-    if bad:
-        parser.error(f"unrecognized arguments: {' '.join(bad)}")
-    return args, rest
+    return parse_known(parser, argv)
 
 
 # ## Optional: the run that writes the file

@@ -23,9 +23,13 @@ Physical groups (name: tag) — the same as the library's scene (rough_contact.s
               end: 19 (free end y = l/2)
 """
 
-import argparse
+import os
+import sys
 
 import gmsh
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))  # _common.py, next to this file
+import _common  # noqa: E402
 
 
 def build(mesh_size=40.0, contact_size=5.0, order=2, w=10.0, hb=120.0, length=500.0, c=5.0,
@@ -40,13 +44,7 @@ def build(mesh_size=40.0, contact_size=5.0, order=2, w=10.0, hb=120.0, length=50
     occ.fragment([(3, beam)], [(2, strip)])
     occ.synchronize()
 
-    def group(dim, name, tag, entities):
-        if not entities:
-            raise ValueError(f"physical group {name!r} selects nothing")
-        gmsh.model.addPhysicalGroup(dim, entities, tag)
-        gmsh.model.setPhysicalName(dim, tag, name)
-
-    group(3, "beam", 1, [t for _, t in gmsh.model.getEntities(3)])
+    _common.group(3, "beam", 1, [t for _, t in gmsh.model.getEntities(3)])
     surfaces = {}
     for _, s in gmsh.model.getEntities(2):
         x, y, z = occ.getCenterOfMass(2, s)
@@ -63,55 +61,22 @@ def build(mesh_size=40.0, contact_size=5.0, order=2, w=10.0, hb=120.0, length=50
         surfaces.setdefault(key, []).append(s)
     for name, tag in dict(contact_beam=11, load=13, top=14, sides=15, symmetry_y=18,
                           end=19).items():
-        group(2, name, tag, surfaces.get(name, []))
+        _common.group(2, name, tag, surfaces.get(name, []))
 
     # element size: contact_size at z = 0, growing to mesh_size at z = transition
-    field = gmsh.model.mesh.field
-    dist = field.add("MathEval")
-    field.setString(dist, "F", "Abs(z)")
-    thr = field.add("Threshold")
-    field.setNumber(thr, "InField", dist)
-    field.setNumber(thr, "SizeMin", contact_size)
-    field.setNumber(thr, "SizeMax", mesh_size)
-    field.setNumber(thr, "DistMin", 0.0)
-    field.setNumber(thr, "DistMax", transition)
-    field.setAsBackgroundMesh(thr)
-    gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
-    gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
-    gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
-    gmsh.option.setNumber("Mesh.MeshSizeMax", mesh_size)
-
-    gmsh.model.mesh.generate(3)
-    if order == 2:
-        gmsh.option.setNumber("Mesh.SecondOrderIncomplete", 0)   # complete 10-node tetrahedra
-        gmsh.model.mesh.setOrder(2)
+    _common.refine_towards("Abs(z)", contact_size, mesh_size, transition)
+    _common.mesh(order)
 
 
 def write(path="beam.msh", show=False, **sizes):
     """Build the mesh in a fresh gmsh session and write it to ``path`` (MSH 4.1)."""
-    gmsh.initialize()
-    try:
-        gmsh.option.setNumber("General.Terminal", 0)
-        gmsh.option.setNumber("General.NumThreads", 1)
-        gmsh.model.add("beam_on_base")
-        build(**sizes)
-        gmsh.write(str(path))
-        if show:
-            gmsh.fltk.run()
-    finally:
-        gmsh.finalize()
-    return path
+    return _common.write(build, "beam_on_base", path, show, **sizes)
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--mesh-size", type=float, default=40.0, help="away from the contact [mm]")
-    ap.add_argument("--contact-size", type=float, default=5.0, help="on the contact [mm]")
-    ap.add_argument("--order", type=int, choices=[1, 2], default=2)
+    ap = _common.parser(__doc__, "beam.msh", mesh_size=40.0, contact_size=5.0)
     ap.add_argument("--load-half-length", dest="c", type=float, default=5.0,
                     help="half length of the loaded strip on the top [mm]")
-    ap.add_argument("-o", "--output", default="beam.msh")
-    ap.add_argument("--show", action="store_true", help="open the result in gmsh's window")
     args = ap.parse_args(argv)
     write(args.output, show=args.show, mesh_size=args.mesh_size,
           contact_size=args.contact_size, order=args.order, c=args.c)

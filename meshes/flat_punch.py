@@ -28,9 +28,13 @@ Physical groups (name: tag) — the same as the library's scene (rough_contact.s
               foundation_sides: 20 (x = L and y = L)
 """
 
-import argparse
+import os
+import sys
 
 import gmsh
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))  # _common.py, next to this file
+import _common  # noqa: E402
 
 
 def build(mesh_size=20.0, contact_size=2.0, order=2, a=10.0, hp=10.0, L=50.0, H=50.0, b=2.5,
@@ -50,15 +54,9 @@ def build(mesh_size=20.0, contact_size=2.0, order=2, a=10.0, hp=10.0, L=50.0, H=
     def centre(dim, tag):
         return occ.getCenterOfMass(dim, tag)
 
-    def group(dim, name, tag, entities):
-        if not entities:
-            raise ValueError(f"physical group {name!r} selects nothing")
-        gmsh.model.addPhysicalGroup(dim, entities, tag)
-        gmsh.model.setPhysicalName(dim, tag, name)
-
     vols = [t for _, t in gmsh.model.getEntities(3)]
-    group(3, "punch", 1, [v for v in vols if centre(3, v)[2] > 0])
-    group(3, "foundation", 2, [v for v in vols if centre(3, v)[2] < 0])
+    _common.group(3, "punch", 1, [v for v in vols if centre(3, v)[2] > 0])
+    _common.group(3, "foundation", 2, [v for v in vols if centre(3, v)[2] < 0])
 
     surfaces = {}
     for _, s in gmsh.model.getEntities(2):
@@ -90,56 +88,23 @@ def build(mesh_size=20.0, contact_size=2.0, order=2, a=10.0, hp=10.0, L=50.0, H=
                 foundation_top=16, symmetry_x=17, symmetry_y=18, fixed=19, foundation_sides=20)
     for name, tag in tags.items():
         if name in surfaces:                    # punch_top is empty when b = a
-            group(2, name, tag, surfaces[name])
+            _common.group(2, name, tag, surfaces[name])
 
     # element size: contact_size at distance 0 from the contact square, mesh_size beyond
-    field = gmsh.model.mesh.field
     dx, dy = f"(Abs(x-{a})+x-{a})/2", f"(Abs(y-{a})+y-{a})/2"
-    dist = field.add("MathEval")
-    field.setString(dist, "F", f"Sqrt(({dx})^2+({dy})^2+z^2)")
-    thr = field.add("Threshold")
-    field.setNumber(thr, "InField", dist)
-    field.setNumber(thr, "SizeMin", contact_size)
-    field.setNumber(thr, "SizeMax", mesh_size)
-    field.setNumber(thr, "DistMin", 0.0)
-    field.setNumber(thr, "DistMax", transition)
-    field.setAsBackgroundMesh(thr)
-    gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
-    gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
-    gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
-    gmsh.option.setNumber("Mesh.MeshSizeMax", mesh_size)
-
-    gmsh.model.mesh.generate(3)
-    if order == 2:
-        gmsh.option.setNumber("Mesh.SecondOrderIncomplete", 0)   # complete 10-node tetrahedra
-        gmsh.model.mesh.setOrder(2)
+    _common.refine_towards(f"Sqrt(({dx})^2+({dy})^2+z^2)", contact_size, mesh_size, transition)
+    _common.mesh(order)
 
 
 def write(path="flat_punch.msh", show=False, **sizes):
     """Build the mesh in a fresh gmsh session and write it to ``path`` (MSH 4.1)."""
-    gmsh.initialize()
-    try:
-        gmsh.option.setNumber("General.Terminal", 0)
-        gmsh.option.setNumber("General.NumThreads", 1)
-        gmsh.model.add("flat_punch")
-        build(**sizes)
-        gmsh.write(str(path))
-        if show:
-            gmsh.fltk.run()
-    finally:
-        gmsh.finalize()
-    return path
+    return _common.write(build, "flat_punch", path, show, **sizes)
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--mesh-size", type=float, default=20.0, help="away from the contact [mm]")
-    ap.add_argument("--contact-size", type=float, default=2.0, help="on the contact [mm]")
-    ap.add_argument("--order", type=int, choices=[1, 2], default=2)
+    ap = _common.parser(__doc__, "flat_punch.msh", mesh_size=20.0, contact_size=2.0)
     ap.add_argument("--load-half-width", dest="b", type=float, default=2.5,
                     help="half width of the loaded square on the punch top [mm]")
-    ap.add_argument("-o", "--output", default="flat_punch.msh")
-    ap.add_argument("--show", action="store_true", help="open the result in gmsh's window")
     args = ap.parse_args(argv)
     write(args.output, show=args.show, mesh_size=args.mesh_size,
           contact_size=args.contact_size, order=args.order, b=args.b)

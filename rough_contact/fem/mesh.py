@@ -49,6 +49,7 @@ __all__ = [
     "write_xdmf",
     "describe",
     "build_scene",
+    "build_contact_scene",
     "gmsh_session",
     "entity_centers",
     "set_transfinite_hexahedra",
@@ -179,6 +180,17 @@ def build_scene(comm: MPI.Comm, name: str, build: typing.Callable, rank: int = 0
     with gmsh_session(comm, rank, name) as model:
         _on_rank(comm, rank, lambda: build(model))
         return scene_from_gmsh(model, comm, rank=rank, **scene_kwargs)
+
+
+def build_contact_scene(comm: MPI.Comm, name: str, build: typing.Callable, bodies: tuple,
+                        contact_pair: tuple, dimensions: dict) -> Scene:
+    """:func:`build_scene` for two deformable bodies in contact. Collective.
+
+    ``bodies = (first, second)`` own the surfaces ``contact_pair = (first, second)``; the first
+    body (the owner of the first contact surface) is the split body.
+    """
+    return build_scene(comm, name, build, split_body=bodies[0], contact_pair=contact_pair,
+                       surface_owners=dict(zip(contact_pair, bodies)), dimensions=dimensions)
 
 
 @contextlib.contextmanager

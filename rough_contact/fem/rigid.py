@@ -53,6 +53,19 @@ def _points(x) -> np.ndarray:
     return x
 
 
+def _radius(name: str, value) -> float:
+    return check_scalar(name, value, lo=0.0, unit="mm")
+
+
+def _radial(d: np.ndarray, radius: float, where: str):
+    """Gap |d| - radius and outward normal d / |d| of a round rigid body (sphere, cylinder) at
+    points whose vectors from its centre (or axis) are ``d`` (n, 3) [mm]."""
+    r = np.linalg.norm(d, axis=1)
+    if np.any(r == 0.0):
+        raise ValueError(f"a contact point lies {where}: its normal is undefined")
+    return r - radius, d / r[:, None]
+
+
 @dataclass(frozen=True)
 class RigidPlane:
     """Half-space behind the plane through ``point`` with outward unit ``normal`` (towards the
@@ -80,16 +93,10 @@ class RigidSphere:
 
     def __post_init__(self):
         object.__setattr__(self, "center", _vector("RigidSphere.center", self.center))
-        object.__setattr__(self, "radius", check_scalar("RigidSphere.radius", self.radius,
-                                                        lo=0.0, unit="mm"))
+        object.__setattr__(self, "radius", _radius("RigidSphere.radius", self.radius))
 
     def gap_and_normal(self, x):
-        d = _points(x) - self.center
-        r = np.linalg.norm(d, axis=1)
-        if np.any(r == 0.0):
-            raise ValueError("a contact point lies at the centre of the RigidSphere: its normal "
-                             "is undefined")
-        return r - self.radius, d / r[:, None]
+        return _radial(_points(x) - self.center, self.radius, "at the centre of the RigidSphere")
 
 
 @dataclass(frozen=True)
@@ -104,17 +111,12 @@ class RigidCylinder:
     def __post_init__(self):
         object.__setattr__(self, "point", _vector("RigidCylinder.point", self.point))
         object.__setattr__(self, "axis", _vector("RigidCylinder.axis", self.axis, True))
-        object.__setattr__(self, "radius", check_scalar("RigidCylinder.radius", self.radius,
-                                                        lo=0.0, unit="mm"))
+        object.__setattr__(self, "radius", _radius("RigidCylinder.radius", self.radius))
 
     def gap_and_normal(self, x):
         d = _points(x) - self.point
-        d = d - np.outer(d @ self.axis, self.axis)
-        r = np.linalg.norm(d, axis=1)
-        if np.any(r == 0.0):
-            raise ValueError("a contact point lies on the axis of the RigidCylinder: its normal "
-                             "is undefined")
-        return r - self.radius, d / r[:, None]
+        return _radial(d - np.outer(d @ self.axis, self.axis), self.radius,
+                       "on the axis of the RigidCylinder")
 
 
 @dataclass(frozen=True)

@@ -429,9 +429,80 @@ def _released(c: FrictionInput, ux, uy, mux, muy):
     return tx, ty, c.elastic_slip_x - tx / c.kt_x, c.elastic_slip_y - ty / c.kt_y, D
 
 
+def _pick(v, idx):
+    """``v`` at the points ``idx``: a per-point array gathered, a scalar (a constant law's
+    coefficient, a fixed weight) as it is."""
+    return v if np.isscalar(v) else v[idx]
+
+
+# ----------------------------------------------------------------------------- return map
+class _SlipHardening:
+    """The return map of both slip-hardening laws, around each law's own corrector.
+
+    The elastic (stick) predictor at every point; at the points whose trial traction lies outside
+    the slip criterion, the closed-form release where the pressure vanishes against the trial
+    traction (``_release``) and the law's scalar return map elsewhere (``_return_map``). A law
+    gives ``_committed_mu(points)`` (the coefficients (mu_x, mu_y) of the criterion at the
+    start of the increment) and ``_corrector(s, mu_x, mu_y, t_trial_x, t_trial_y)`` at the
+    slipping points: the release mask and the per-point values its two correctors take.
+    """
+
+    def evaluate(self, points: FrictionInput, traction: Optional[np.ndarray] = None,
+                 tangent: Optional[np.ndarray] = None) -> FrictionOutput:
+        """Backward-Euler return map and algorithmic tangent at m contact points (hot path).
+
+        Pure: ``points`` is read, never written. The results are written into ``traction`` and
+        ``tangent`` when given (e.g. views into the composed law's (n, 3) and (n, 3, 3) arrays,
+        which saves a copy), else into new arrays. Only shapes are checked here; the values are
+        trusted (finite, p >= 0, kT > 0: what the composed law produces from a finite jump);
+        callers with unchecked data build ``points`` with ``FrictionInput.from_pairs``.
+
+        Args:
+            points: the inputs at m points (``FrictionInput``).
+            traction: optional (m, 2) float64 output for (t_x, t_y) [MPa].
+            tangent: optional (m, 2, 3) float64 output for d t_T / d(g, s_x, s_y) [MPa/mm].
+
+        Returns:
+            ``FrictionOutput``: traction and tangent at all m points, and the plastic slip
+            increments at the k slipping points.
+
+        Raises:
+            ValueError: wrong types or shapes. ReturnMappingError (a ``ConvergenceError``): the
+                local Newton did not converge.
+        """
+        out_t, out_D = _outputs(points, traction, tangent)
+        mux, muy = self._committed_mu(points)
+        tx, ty = _write_stick(points, out_t, out_D)
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            qx = tx / (mux * points.pressure)
+            qy = ty / (muy * points.pressure)
+            slipping = qx * qx + qy * qy > 1.0
+        if not slipping.any():
+            return _no_slip(out_t, out_D)
+        idx = np.flatnonzero(slipping)
+        s = points.take(idx)
+        released, values = self._corrector(s, _pick(mux, idx), _pick(muy, idx), tx.take(idx),
+                                           ty.take(idx))
+        dspx = np.empty(idx.size)
+        dspy = np.empty(idx.size)
+        its = 0
+        if released.any():
+            r = np.flatnonzero(released)
+            rtx, rty, dspx[r], dspy[r], D = self._release(s.take(r), *(_pick(v, r)
+                                                                       for v in values))
+            _write_slip(idx[r], out_t, out_D, rtx, rty, D)
+        if not released.all():
+            g = np.flatnonzero(~released) if released.any() else slice(None)
+            sg = s.take(g) if released.any() else s
+            gtx, gty, dspx[g], dspy[g], D, its = self._return_map(sg, *(_pick(v, g)
+                                                                        for v in values))
+            _write_slip(idx[g], out_t, out_D, gtx, gty, D)
+        return FrictionOutput(out_t, out_D, idx, dspx, dspy, _norm(dspx, dspy), its)
+
+
 # ----------------------------------------------------------------------------- orthotropic
 @dataclass(frozen=True)
-class OrthotropicSlipHardening:
+class OrthotropicSlipHardening(_SlipHardening):
     """Orthotropic slip-hardening friction, eqs (89)-(118).
 
     Args:
@@ -499,76 +570,26 @@ class OrthotropicSlipHardening:
         t = np.asarray(traction_t, dtype=float)
         return np.hypot(t[:, 0] / mu[:, 0], t[:, 1] / mu[:, 1]) - np.asarray(pressure, dtype=float)
 
-    def evaluate(self, points: FrictionInput, traction: Optional[np.ndarray] = None,
-                 tangent: Optional[np.ndarray] = None) -> FrictionOutput:
-        """Backward-Euler return map and algorithmic tangent at m contact points (hot path).
-
-        Pure: ``points`` is read, never written. The results are written into ``traction`` and
-        ``tangent`` when given (e.g. views into the composed law's (n, 3) and (n, 3, 3) arrays,
-        which saves a copy), else into new arrays. Only shapes are checked here; the values are
-        trusted (finite, p >= 0, kT > 0: what the composed law produces from a finite jump);
-        callers with unchecked data build ``points`` with ``FrictionInput.from_pairs``.
-
-        Args:
-            points: the inputs at m points (``FrictionInput``).
-            traction: optional (m, 2) float64 output for (t_x, t_y) [MPa].
-            tangent: optional (m, 2, 3) float64 output for d t_T / d(g, s_x, s_y) [MPa/mm].
-
-        Returns:
-            ``FrictionOutput``: traction and tangent at all m points, and the plastic slip
-            increments at the k slipping points.
-
-        Raises:
-            ValueError: wrong types or shapes. ReturnMappingError (a ``ConvergenceError``): the
-                local Newton did not converge.
-        """
-        out_t, out_D = _outputs(points, traction, tangent)
-        c = points
+    # -- return map ----------------------------------------------------------------------
+    def _committed_mu(self, c: FrictionInput):
         mux, _, muy, _ = self._mu(c.kappa_x, c.kappa_y)
-        tx, ty = _write_stick(c, out_t, out_D)
-        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-            qx = tx / (mux * c.pressure)
-            qy = ty / (muy * c.pressure)
-            slipping = qx * qx + qy * qy > 1.0
-        if not slipping.any():
-            return _no_slip(out_t, out_D)
-        idx = np.flatnonzero(slipping)
-        s = c.take(idx)
-        mux_s = mux if np.isscalar(mux) else mux.take(idx)
-        muy_s = muy if np.isscalar(muy) else muy.take(idx)
-        wx, wy = self._weights(mux_s, muy_s)
-        cx, cy = tx.take(idx), ty.take(idx)
+        return mux, muy
+
+    def _corrector(self, s: FrictionInput, mux, muy, cx, cy):
+        wx, wy = self._weights(mux, muy)
         ax = s.kt_x * wx
         ay = s.kt_y * wy
-        ntr = _norm(cx / mux_s, cy / muy_s)
+        ntr = _norm(cx / mux, cy / muy)
         released = ntr * (_RELEASE * _spread(ax, ay)) > s.pressure
-        dspx = np.empty(idx.size)
-        dspy = np.empty(idx.size)
-        its = 0
-        if released.any():
-            r = np.flatnonzero(released)
-            sr = s.take(r)
-            wyr = wy if np.isscalar(wy) else wy.take(r)
-            ux, uy = sr.elastic_slip_x / wx, sr.elastic_slip_y / wyr
-            mx, _, my, _ = self._mu(sr.kappa_x + np.abs(sr.elastic_slip_x),
-                                    sr.kappa_y + np.abs(sr.elastic_slip_y))
-            rtx, rty, dspx[r], dspy[r], D = _released(sr, ux, uy, mx, my)
-            _write_slip(idx[r], out_t, out_D, rtx, rty, D)
-        if not released.all():
-            g = np.flatnonzero(~released)
-            if released.any():
-                sg = s.take(g)
-                pick = lambda v: v if np.isscalar(v) else v.take(g)  # noqa: E731
-                res = self._slip(sg, pick(mux_s), pick(muy_s), pick(wy), cx.take(g), cy.take(g),
-                                 pick(ntr), ax.take(g), pick(ay))
-            else:
-                g = slice(None)
-                res = self._slip(s, mux_s, muy_s, wy, cx, cy, ntr, ax, ay)
-            gtx, gty, dspx[g], dspy[g], D, its = res
-            _write_slip(idx[g], out_t, out_D, gtx, gty, D)
-        return FrictionOutput(out_t, out_D, idx, dspx, dspy, _norm(dspx, dspy), its)
+        return released, (mux, muy, wy, cx, cy, ntr, ax, ay)
 
-    def _slip(self, s: FrictionInput, mux_n, muy_n, wy, cx, cy, ntr, ax, ay):
+    def _release(self, s: FrictionInput, _mux, _muy, wy, *_):
+        ux, uy = s.elastic_slip_x, s.elastic_slip_y / wy       # w_x = 1
+        mx, _, my, _ = self._mu(s.kappa_x + np.abs(s.elastic_slip_x),
+                                s.kappa_y + np.abs(s.elastic_slip_y))
+        return _released(s, ux, uy, mx, my)
+
+    def _return_map(self, s: FrictionInput, mux_n, muy_n, wy, cx, cy, ntr, ax, ay):
         mmx, mmy = self.mu_macro
         wx = 1.0
         acx, acy = np.abs(cx), np.abs(cy)
@@ -618,7 +639,7 @@ class OrthotropicSlipHardening:
 
 # ----------------------------------------------------------------------------- isotropic
 @dataclass(frozen=True)
-class IsotropicSlipHardening:
+class IsotropicSlipHardening(_SlipHardening):
     """Isotropic slip-hardening friction (Fredriksson), eqs (119)-(131).
 
     Args:
@@ -659,66 +680,24 @@ class IsotropicSlipHardening:
         t = np.asarray(traction_t, dtype=float)
         return np.hypot(t[:, 0], t[:, 1]) - mu * np.asarray(pressure, dtype=float)
 
-    def evaluate(self, points: FrictionInput, traction: Optional[np.ndarray] = None,
-                 tangent: Optional[np.ndarray] = None) -> FrictionOutput:
-        """Return map (radial when kTx == kTy) and algorithmic tangent at m points (hot path).
-
-        Pure: ``points`` is read, never written. The results are written into ``traction`` and
-        ``tangent`` when given (e.g. views into the composed law's (n, 3) and (n, 3, 3) arrays,
-        which saves a copy), else into new arrays. Only shapes are checked here; the values are
-        trusted (finite, p >= 0, kT > 0: what the composed law produces from a finite jump);
-        callers with unchecked data build ``points`` with ``FrictionInput.from_pairs``.
-
-        Args:
-            points: the inputs at m points (``FrictionInput``).
-            traction: optional (m, 2) float64 output for (t_x, t_y) [MPa].
-            tangent: optional (m, 2, 3) float64 output for d t_T / d(g, s_x, s_y) [MPa/mm].
-
-        Returns:
-            ``FrictionOutput``: traction and tangent at all m points, and the plastic slip
-            increments at the k slipping points.
-
-        Raises:
-            ValueError: wrong types or shapes. ReturnMappingError (a ``ConvergenceError``): the
-                local Newton did not converge.
-        """
-        out_t, out_D = _outputs(points, traction, tangent)
-        c = points
+    # -- return map ----------------------------------------------------------------------
+    def _committed_mu(self, c: FrictionInput):
         mu, _ = self._mu(c.slip_path)
-        tx, ty = _write_stick(c, out_t, out_D)
-        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-            lim = mu * c.pressure
-            qx = tx / lim
-            qy = ty / lim
-            slipping = qx * qx + qy * qy > 1.0
-        if not slipping.any():
-            return _no_slip(out_t, out_D)
-        idx = np.flatnonzero(slipping)
-        s = c.take(idx)
-        mu_s = mu if np.isscalar(mu) else mu.take(idx)
-        cx, cy = tx.take(idx), ty.take(idx)
+        return mu, mu
+
+    def _corrector(self, s: FrictionInput, mu, _, cx, cy):
         T = _norm(cx, cy)
-        released = T * (_RELEASE * _spread(s.kt_x, s.kt_y)) > mu_s * s.pressure
-        dspx = np.empty(idx.size)
-        dspy = np.empty(idx.size)
-        its = 0
-        if released.any():
-            r = np.flatnonzero(released)
-            sr = s.take(r)
-            mr, _ = self._mu(sr.slip_path + np.hypot(sr.elastic_slip_x, sr.elastic_slip_y))
-            rtx, rty, dspx[r], dspy[r], D = _released(sr, sr.elastic_slip_x, sr.elastic_slip_y,
-                                                      mr, mr)
-            _write_slip(idx[r], out_t, out_D, rtx, rty, D)
-        if not released.all():
-            g = np.flatnonzero(~released) if released.any() else slice(None)
-            sg = s.take(g) if released.any() else s
-            pick = (lambda v: v if np.isscalar(v) else v[g])  # noqa: E731
-            args = (sg, pick(mu_s), cx[g], cy[g], T[g])
-            radial = np.array_equal(sg.kt_x, sg.kt_y) and np.array_equal(sg.dkt_x, sg.dkt_y)
-            gtx, gty, dspx[g], dspy[g], D, its = (self._radial(*args) if radial
-                                                  else self._general(*args))
-            _write_slip(idx[g], out_t, out_D, gtx, gty, D)
-        return FrictionOutput(out_t, out_D, idx, dspx, dspy, _norm(dspx, dspy), its)
+        released = T * (_RELEASE * _spread(s.kt_x, s.kt_y)) > mu * s.pressure
+        return released, (mu, cx, cy, T)
+
+    def _release(self, s: FrictionInput, *_):
+        mu, _ = self._mu(s.slip_path + np.hypot(s.elastic_slip_x, s.elastic_slip_y))
+        return _released(s, s.elastic_slip_x, s.elastic_slip_y, mu, mu)
+
+    def _return_map(self, s: FrictionInput, mu_n, cx, cy, T):
+        """Radial when kTx == kTy (and dkTx == dkTy), else the general scalar return map."""
+        radial = np.array_equal(s.kt_x, s.kt_y) and np.array_equal(s.dkt_x, s.dkt_y)
+        return (self._radial if radial else self._general)(s, mu_n, cx, cy, T)
 
     def _radial(self, s: FrictionInput, mu_n, cx, cy, T):
         """kTx == kTy: t = tau m, m = t_trial/|t_trial|, tau = p mu(kappa_n + (T - tau)/k)."""

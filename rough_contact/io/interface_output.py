@@ -105,7 +105,23 @@ class InterfaceOutputSource(Protocol):
 # point and facet fields (pure numpy)
 # --------------------------------------------------------------------------------------------
 @dataclass(frozen=True)
-class PointOutput:
+class _InterfaceFields:
+    """The fields of the points and of the facets (``_FIELDS``, in that order); what they are at
+    each: :class:`PointOutput`, :class:`FacetOutput`."""
+
+    pressure: np.ndarray
+    area_fraction: np.ndarray
+    gap: np.ndarray
+    slip: np.ndarray
+    plastic_slip: np.ndarray
+    traction: np.ndarray
+    shear_traction: np.ndarray
+    dissipation: np.ndarray
+    status: np.ndarray
+
+
+@dataclass(frozen=True)
+class PointOutput(_InterfaceFields):
     """Interface fields at this rank's quadrature points, vectors in global axes.
 
     Attributes:
@@ -122,20 +138,11 @@ class PointOutput:
         weight: (n,) area represented by the point [mm^2].
     """
 
-    pressure: np.ndarray
-    area_fraction: np.ndarray
-    gap: np.ndarray
-    slip: np.ndarray
-    plastic_slip: np.ndarray
-    traction: np.ndarray
-    shear_traction: np.ndarray
-    dissipation: np.ndarray
-    status: np.ndarray
     weight: np.ndarray
 
 
 @dataclass(frozen=True)
-class FacetOutput:
+class FacetOutput(_InterfaceFields):
     """Interface fields per owned facet of the first surface (DG0, quadrature averages).
 
     Attributes:
@@ -147,15 +154,6 @@ class FacetOutput:
         area: (n_f,) facet area, sum of its quadrature weights [mm^2].
     """
 
-    pressure: np.ndarray
-    area_fraction: np.ndarray
-    gap: np.ndarray
-    slip: np.ndarray
-    plastic_slip: np.ndarray
-    traction: np.ndarray
-    shear_traction: np.ndarray
-    dissipation: np.ndarray
-    status: np.ndarray
     contact_fraction: np.ndarray
     slip_fraction: np.ndarray
     area: np.ndarray

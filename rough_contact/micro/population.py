@@ -145,6 +145,14 @@ def _check_h(h):
     return h
 
 
+def _separations(surface: SpectralMoments, h):
+    """Checked separations ``h`` [mm] of the population sums: (h's shape, the flat
+    l = h / sqrt(m00 mu) [-], sqrt(m00 mu) [mm], the summit density D_s)."""
+    h = _check_h(h)
+    smu = math.sqrt(surface.m00 * surface.mu)
+    return h.shape, h.ravel() / smu, smu, surface.summit_density
+
+
 def _check_nquad(n):
     v = check_scalar("n_quad", n, lo=4, hi=400, lo_open=False, hi_open=False)
     if v != int(v):
@@ -295,17 +303,12 @@ def elastic(surface: SpectralMoments, E_star: float, h, n_quad: int = 32,
     """
     E_star = check_scalar("E_star", E_star, lo=0.0, unit="MPa")
     n_quad = _check_nquad(n_quad)
-    h = _check_h(h)
-    shape = h.shape
-    hf = h.ravel()
-    smu = math.sqrt(surface.m00 * surface.mu)
-    l = hf / smu
-    Ds = surface.summit_density
-    A = np.zeros(hf.size)
-    W = np.zeros(hf.size)
-    Kn = np.zeros(hf.size)
+    shape, l, smu, Ds = _separations(surface, h)
+    A = np.zeros(l.size)
+    W = np.zeros(l.size)
+    Kn = np.zeros(l.size)
     per_h = 3 * n_quad * 3 * n_quad
-    for sl in _chunks(hf.size, per_h):
+    for sl in _chunks(l.size, per_h):
         r4, r6, d, logw = _outer_nodes(surface, l[sl], n_quad)
         kappa, _, _, f1, f2, _, _ = _asperity_shape(surface, r4, r6, elliptic, eccentricity)
         F1 = log_F_n(1.0, d)[..., None]
@@ -346,23 +349,18 @@ def elasto_plastic(surface: SpectralMoments, material: AsperityMaterial, h, n_qu
     """
     mat = material.resolve(surface)
     n_quad = _check_nquad(n_quad)
-    h = _check_h(h)
-    shape = h.shape
-    hf = h.ravel()
-    smu = math.sqrt(surface.m00 * surface.mu)
-    l = hf / smu
-    Ds = surface.summit_density
+    shape, l, smu, Ds = _separations(surface, h)
     Es, H, ch, R = mat.E_star, mat.H, mat.ch, mat.omega_p_ratio
     pY = mat.yield_pressure
     slope = H * (ch - 2.0 * mat.K_nu / 3.0) / math.log(R)
-    out = {k: np.zeros(hf.size) for k in ("Ae", "At", "Ap", "We", "Wt", "Wp", "K")}
+    out = {k: np.zeros(l.size) for k in ("Ae", "At", "Ap", "We", "Wt", "Wp", "K")}
     n_t = max(16, (2 * n_quad) // 3) if n_t is None else _check_nquad(n_t)
     u, w = _gl01(n_t)
     # 1.5x more nodes along p: in deep contact the elastic/transition boundary of the flat
     # (small-p) asperities is a narrow feature in p (measured: 2e-4 -> 2e-5 at h = -5 sigma)
     n_p = (3 * n_quad) // 2
     per_h = 3 * n_p * 3 * n_quad * 4 * n_t
-    for sl in _chunks(hf.size, per_h, budget=1_000_000):
+    for sl in _chunks(l.size, per_h, budget=1_000_000):
         r4, r6, d, logw = _outer_nodes(surface, l[sl], n_quad, n_p)
         kappa, _, _, f1, f2, f3, KE = _asperity_shape(surface, r4, r6, elliptic, eccentricity)
         wc = KE * (pY / Es) ** 2 / kappa          # (65) [mm]

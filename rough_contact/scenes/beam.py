@@ -31,9 +31,9 @@ from rough_contact.io import ResultWriter, atomic_write_text, gather_points
 from rough_contact.scenes.defaults import SEATING_STIFFNESS
 from rough_contact.scenes.defaults import quadrature_degree as default_qdeg
 from rough_contact.scenes.meshes.beam import beam_on_base
+from rough_contact.scenes.setup import check_mesh_arguments
 from rough_contact.solver.loading import load_path
 from rough_contact.solver.snes import SNESSolver
-from rough_contact.validation import check_scalar
 
 # Silence the INFO lines of the JIT compiler (setuptools resets the root logger's level).
 logging.getLogger().addFilter(lambda record: record.levelno >= logging.WARNING)
@@ -172,11 +172,8 @@ class BeamCase:
 def build_scene(comm=MPI.COMM_WORLD, mesh_size=40.0, contact_size=5.0, order=2,
                 load_half_length=5.0):
     """Half beam mesh, space and the symmetry condition (shared by all cases). Collective."""
-    check_scalar("mesh_size", mesh_size, lo=0.0, unit="mm")
-    check_scalar("contact_size", contact_size, lo=0.0, unit="mm")
-    check_scalar("load_half_length", load_half_length, lo=0.0, unit="mm")
-    if order not in (1, 2):
-        raise ValueError(f"order = {order!r} is invalid: it must be 1 or 2")
+    check_mesh_arguments(order, mesh_size=mesh_size, contact_size=contact_size,
+                         load_half_length=load_half_length)
     scene = beam_on_base(mesh_size=mesh_size, contact_size=contact_size, order=order,
                          load_half_length=load_half_length, comm=comm)
     V = vector_space(scene.mesh, order)

@@ -25,13 +25,11 @@ import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from rough_contact.fem.boundary import fix
 from rough_contact.fem.compat import vector_space
-from rough_contact.fem.contact import ContactInterface
-from rough_contact.fem.problem import (ContactProblem, Material, PrescribedDisplacement,
-                                       SurfaceLoad)
+from rough_contact.fem.problem import Material
 from rough_contact.scenes import flat_punch
-from rough_contact.scenes.defaults import GRAIN_X, SEATING_STIFFNESS, quadrature_degree
+from rough_contact.scenes.defaults import GRAIN_X, quadrature_degree
+from rough_contact.scenes.setup import clamped_pair, preload_then_drive
 from rough_contact.scenes.meshes.blocks import cylinder_on_block
 from rough_contact.solver.loading import load_path
 from rough_contact.solver.program import LoadProgram
@@ -116,24 +114,15 @@ def run(pressure=10.0, slide_um=2.0, radius=5.0, height=5.0, size_cylinder=1.0,
     scene = cylinder_on_block(radius=radius, height=height, size_cylinder=size_cylinder,
                               size_block=size_block, order=order, comm=comm)
     V = vector_space(scene.mesh, order)
-    clamp = fix(V, scene.facet_tags, scene.tag("bottom"))
     P = pressure * np.pi * radius**2
     law, _ = flat_punch.make_law(comm, case="b", normal_law="elastic",
                                  seating_pressure=pressure / preload_steps)
-    first, second = scene.contact_pair
-    interface = ContactInterface(V, scene.facet_tags, first, second, law=law, bcs=[clamp],
-                                 grain_direction=GRAIN_X,
-                                 quadrature_degree=quadrature_degree(order),
-                                 pairing=pairing)
+    clamp, interface = clamped_pair(scene, V, law, grain_direction=GRAIN_X,
+                                    quadrature_degree=quadrature_degree(order), pairing=pairing)
     top = scene.tag("cylinder_top")
     prog = program(preload_steps, shear_steps)
-    problem = ContactProblem(
-        V, Material(flat_punch.E, flat_punch.NU), [clamp],
-        [SurfaceLoad(top, force=(0.0, 0.0, -P), channel="preload")],
-        facet_tags=scene.facet_tags, interface=interface, seating_tag=first,
-        seating_stiffness=SEATING_STIFFNESS,
-        prescribed=[PrescribedDisplacement(top, (slide, 0.0, 0.0), (0,), channel="shear")],
-        programs=prog.channels)
+    problem = preload_then_drive(scene, V, Material(flat_punch.E, flat_punch.NU), clamp,
+                                 interface, top, P, slide, "shear", prog.channels)
     solver = SNESSolver(problem, prefix="bolt_")
     rows = []
     if verbose:

@@ -38,6 +38,7 @@ from rough_contact.references import effective_modulus
 from rough_contact.scenes.defaults import GRAIN_X, SEATING_STIFFNESS
 from rough_contact.scenes.defaults import quadrature_degree as default_qdeg
 from rough_contact.scenes.meshes.flat_punch import flat_punch
+from rough_contact.scenes.setup import check_mesh_arguments
 from rough_contact.solver.loading import load_path, load_unload_factors
 from rough_contact.solver.snes import SNESSolver
 from rough_contact.validation import check_scalar
@@ -135,11 +136,8 @@ class PunchScene:
 def quarter_punch(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2,
                   load_half_width=2.5, cell_type="tetrahedron") -> PunchScene:
     """Mesh the quarter punch and set its space and boundary conditions. Collective."""
-    check_scalar("mesh_size", mesh_size, lo=0.0, unit="mm")
-    check_scalar("contact_size", contact_size, lo=0.0, unit="mm")
-    check_scalar("load_half_width", load_half_width, lo=0.0, unit="mm")
-    if order not in (1, 2):
-        raise ValueError(f"order = {order!r} is invalid: it must be 1 or 2")
+    check_mesh_arguments(order, mesh_size=mesh_size, contact_size=contact_size,
+                         load_half_width=load_half_width)
     scene = flat_punch(mesh_size=mesh_size, contact_size=contact_size, order=order,
                        load_half_width=load_half_width, cell_type=cell_type, comm=comm)
     V = vector_space(scene.mesh, order)

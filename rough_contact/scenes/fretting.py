@@ -26,14 +26,12 @@ import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from rough_contact.fem.boundary import fix
 from rough_contact.fem.compat import vector_space
-from rough_contact.fem.contact import ContactInterface
-from rough_contact.fem.problem import (ContactProblem, Material, PrescribedDisplacement,
-                                       SurfaceLoad)
+from rough_contact.fem.problem import Material
 from rough_contact.io import CsvRecorder
 from rough_contact.scenes import flat_punch
-from rough_contact.scenes.defaults import SEATING_STIFFNESS, quadrature_degree
+from rough_contact.scenes.defaults import quadrature_degree
+from rough_contact.scenes.setup import clamped_pair, preload_then_drive
 from rough_contact.scenes.meshes.blocks import two_blocks
 from rough_contact.solver.checkpoint import has_checkpoint
 from rough_contact.solver.loading import load_path
@@ -117,23 +115,14 @@ def run_amplitude(amplitude_um: float, *, size=2.0, height=1.0, mesh_size=0.5, o
                                   mesh_size=mesh_size, order=order, comm=comm)
     scene = _SCENES[key]
     V = vector_space(scene.mesh, order)
-    clamp = fix(V, scene.facet_tags, scene.tag("bottom"))
     force = pressure * size * size
     law, normal = flat_punch.make_law(comm, case="b", normal_law="elastic",
                                       seating_pressure=pressure / preload_steps, normal=normal)
-    first, second = scene.contact_pair
-    ci = ContactInterface(V, scene.facet_tags, first, second, law=law, bcs=[clamp],
-                          quadrature_degree=quadrature_degree(order))
+    clamp, ci = clamped_pair(scene, V, law, quadrature_degree=quadrature_degree(order))
     top = scene.tag("top")
     prog = preload_then_cyclic(preload_steps, cycles, steps_per_cycle)
-    E, NU = flat_punch.E, flat_punch.NU
-    problem = ContactProblem(
-        V, Material(E, NU), [clamp], [SurfaceLoad(top, force=(0.0, 0.0, -force),
-                                                  channel="preload")],
-        facet_tags=scene.facet_tags, interface=ci, seating_tag=first,
-        seating_stiffness=SEATING_STIFFNESS,
-        prescribed=[PrescribedDisplacement(top, (a, 0.0, 0.0), (0,), channel="cyclic")],
-        programs=prog.channels)
+    problem = preload_then_drive(scene, V, Material(flat_punch.E, flat_punch.NU), clamp, ci, top,
+                                 force, a, "cyclic", prog.channels)
     solver = SNESSolver(problem, prefix="fret_")
     rec = CsvRecorder(loop_csv, LOOP_COLUMNS, comm)
     solved = 0

@@ -23,24 +23,21 @@ from __future__ import annotations
 import json
 import os
 import shutil
-import signal
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
 import pytest
+from kill_rank import kill_checkpointed_run, worker_cmd
 
 MPIRUN = shutil.which("mpirun")
-WORKER = Path(__file__).with_name("checkpoint_worker.py")
 ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
            OPENBLAS_NUM_THREADS="1")
 
 
 def _run(mode, directory, out, timeout=600):
-    cmd = [MPIRUN, "-n", "2", sys.executable, str(WORKER), mode, str(directory), str(out)]
-    proc = subprocess.run(cmd, env=ENV, capture_output=True, text=True, timeout=timeout)
+    proc = subprocess.run(worker_cmd(mode, directory, out), env=ENV, capture_output=True, text=True, timeout=timeout)
     assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
     return json.loads(Path(out).read_text())
 
@@ -75,22 +72,7 @@ def test_sigkill_then_resume(tmp_path):
     reference = _run("full", tmp_path / "unused", tmp_path / "full.json")
     for kill_after in (3, 7, 12):
         directory = tmp_path / f"ckpt_{kill_after}"
-        cmd = [MPIRUN, "-n", "2", sys.executable, str(WORKER), "checkpointed", str(directory),
-               str(tmp_path / "never.json")]
-        proc = subprocess.Popen(cmd, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
-                                text=True)
-        pids, killed = {}, False
-        deadline = time.time() + 600
-        for line in proc.stdout:
-            parts = line.split()
-            if parts[:1] == ["PIDS"]:
-                pids = {rank: int(p) for rank, p in enumerate(parts[1:])}
-            elif parts[:1] == ["STEP"] and int(parts[1]) >= kill_after and not killed:
-                os.kill(pids[1], signal.SIGKILL)
-                killed = True
-            if time.time() > deadline:
-                break
-        proc.wait(timeout=120)
+        proc, killed = kill_checkpointed_run(directory, tmp_path / "never.json", ENV, kill_after)
         assert killed and proc.returncode != 0           # the run did die
         resumed = _run("resume", directory, tmp_path / f"resumed_{kill_after}.json")
         assert resumed["step"] == reference["step"]

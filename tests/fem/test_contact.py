@@ -133,13 +133,19 @@ def test_against_ufl_linear_penalty_rigid(degree):
     V = compat.vector_space(msh, degree)
     k = 1.7e3
     ci = ContactInterface(V, tags, LOWER_TOP, law=LinearPenalty(k), quadrature_degree=2 * degree)
+    _assert_is_ufl_penalty(ci, V, k, ufl.Measure("ds", domain=msh, subdomain_data=tags)(LOWER_TOP))
+    np.testing.assert_allclose(ci.nominal_area(), 1.0, rtol=1e-13)
+
+
+def _assert_is_ufl_penalty(ci, V, k, ds):
+    """At a smooth field, the residual and Jacobian of ``ci`` are those of the UFL form
+    k (u.n)(v.n) ``ds`` (to 1e-12; ``ds``: the measure of the contact face)."""
     u = fem.Function(V)
     u.interpolate(smooth_field)
     v, du = ufl.TestFunction(V), ufl.TrialFunction(V)
-    n = ufl.FacetNormal(msh)
-    ds = ufl.Measure("ds", domain=msh, subdomain_data=tags)
-    F = fem.form(k * ufl.inner(u, n) * ufl.inner(v, n) * ds(LOWER_TOP))
-    a = fem.form(k * ufl.inner(du, n) * ufl.inner(v, n) * ds(LOWER_TOP))
+    n = ufl.FacetNormal(V.mesh)
+    F = fem.form(k * ufl.inner(u, n) * ufl.inner(v, n) * ds)
+    a = fem.form(k * ufl.inner(du, n) * ufl.inner(v, n) * ds)
     b_ufl = dolfinx.fem.petsc.assemble_vector(F)
     b_ufl.ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)
     b_ci = residual(ci, V, u)
@@ -157,7 +163,6 @@ def test_against_ufl_linear_penalty_rigid(degree):
     nrm = A_ufl.norm()
     A_ci.axpy(-1.0, A_ufl, PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
     assert A_ci.norm() <= 1e-12 * nrm
-    np.testing.assert_allclose(ci.nominal_area(), 1.0, rtol=1e-13)
 
 
 def test_create_matrix_holds_bulk_and_interface():
@@ -284,6 +289,21 @@ def test_uniform_jump_patch():
     assert st.n_slipping == 0 and st.slipping_area == 0.0 and st.dissipation == 0.0
 
 
+def _coulomb_assembled(V, tags, bcs=()):
+    """A softplus Coulomb interface between the blocks (with ``bcs``), its residual and its
+    assembled Jacobian (in the bulk pattern) at a smooth field: (interface, b, A)."""
+    law = SoftplusPenalty(1e4, 1e-3, k_tangential=5e3, friction=0.3)
+    ci = ContactInterface(V, tags, LOWER_TOP, UPPER_BOTTOM, law=law, bcs=bcs)
+    u = fem.Function(V)
+    interpolate_bodies(u, lambda x, up: smooth_field(x, up, 2e-3))
+    b = residual(ci, V, u)
+    A = ci.create_matrix(fem.form(ufl.inner(ufl.TrialFunction(V), ufl.TestFunction(V)) * ufl.dx))
+    ci.evaluate(u)
+    ci.assemble_jacobian(A)
+    A.assemble()
+    return ci, b, A
+
+
 def _global_figures(comm, degree, patch):
     msh, tags = two_blocks(comm, n=(4, 3, 1))
     if patch:  # keep only a small patch of the interface tagged: most ranks own none of it
@@ -294,15 +314,7 @@ def _global_figures(comm, degree, patch):
         ).astype(np.int32)
         tags = dmesh.meshtags(msh, 2, tags.indices, vals)
     V = compat.vector_space(msh, degree)
-    law = SoftplusPenalty(1e4, 1e-3, k_tangential=5e3, friction=0.3)
-    ci = ContactInterface(V, tags, LOWER_TOP, UPPER_BOTTOM, law=law)
-    u = fem.Function(V)
-    interpolate_bodies(u, lambda x, up: smooth_field(x, up, 2e-3))
-    b = residual(ci, V, u)
-    A = ci.create_matrix(fem.form(ufl.inner(ufl.TrialFunction(V), ufl.TestFunction(V)) * ufl.dx))
-    ci.evaluate(u)
-    ci.assemble_jacobian(A)
-    A.assemble()
+    ci, b, A = _coulomb_assembled(V, tags)
     ci.commit()
     st = ci.summary()
     return (
@@ -447,27 +459,9 @@ def test_against_ufl_gmsh_block_on_plane(cell_type, order):
     first, _ = sc.contact_pair
     ci = ContactInterface(V, sc.facet_tags, first, None, law=LinearPenalty(k),
                           rigid_plane=sc.rigid_plane, quadrature_degree=2 * order + 1)
-    u = fem.Function(V)
-    u.interpolate(smooth_field)
-    v, du = ufl.TestFunction(V), ufl.TrialFunction(V)
-    n = ufl.FacetNormal(sc.mesh)
     ds = ufl.Measure("ds", domain=sc.mesh, subdomain_data=sc.facet_tags,
                      metadata={"quadrature_degree": 2 * order + 1})
-    F = fem.form(k * ufl.inner(u, n) * ufl.inner(v, n) * ds(first))
-    b_ufl = dolfinx.fem.petsc.assemble_vector(F)
-    b_ufl.ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)
-    b_ci = residual(ci, V, u)
-    b_ci.axpy(-1.0, b_ufl)
-    assert b_ci.norm() <= 1e-12 * b_ufl.norm()
-    a = fem.form(k * ufl.inner(du, n) * ufl.inner(v, n) * ds(first))
-    A_ufl = dolfinx.fem.petsc.assemble_matrix(a)
-    A_ufl.assemble()
-    A_ci = ci.create_matrix(a)
-    ci.evaluate(u)
-    ci.assemble_jacobian(A_ci)
-    A_ci.assemble()
-    A_ci.axpy(-1.0, A_ufl, PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
-    assert A_ci.norm() <= 1e-12 * A_ufl.norm()
+    _assert_is_ufl_penalty(ci, V, k, ds(first))
 
 
 def _partner_figures(c, split, degree, pairing):
@@ -555,15 +549,7 @@ def test_dirichlet_dofs_are_skipped(degree):
     V0, _ = V.sub(0).collapse()
     dofs = fem.locate_dofs_topological((V.sub(0), V0), fdim, side)
     bc = fem.dirichletbc(fem.Function(V0), dofs, V.sub(0))
-    law = SoftplusPenalty(1e4, 1e-3, k_tangential=5e3, friction=0.3)
-    ci = ContactInterface(V, tags, LOWER_TOP, UPPER_BOTTOM, law=law, bcs=[bc])
-    u = fem.Function(V)
-    interpolate_bodies(u, lambda x, up: smooth_field(x, up, 2e-3))
-    b = residual(ci, V, u)
-    A = ci.create_matrix(fem.form(ufl.inner(ufl.TrialFunction(V), ufl.TestFunction(V)) * ufl.dx))
-    ci.evaluate(u)
-    ci.assemble_jacobian(A)
-    A.assemble()
+    ci, b, A = _coulomb_assembled(V, tags, bcs=[bc])
     # owned bc DOFs as global scalar indices
     local = np.asarray(bc.dof_indices()[0])
     local = local[local < 3 * V.dofmap.index_map.size_local]

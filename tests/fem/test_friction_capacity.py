@@ -12,14 +12,13 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from petsc4py import PETSc
 
 from dolfinx import fem
 from rough_contact.fem import compat
-from rough_contact.fem.contact import ContactInterface
 from rough_contact.fem.problem import ContactProblem, Material, SurfaceLoad
 from rough_contact.interface.penalty import SoftplusPenalty
 from rough_contact.scenes.meshes.blocks import two_blocks
+from rough_contact.scenes.setup import clamped_pair
 from rough_contact.solver.loading import FrictionCapacityError, load_path
 from rough_contact.solver.snes import SNESSolver
 from rough_contact.scenes.defaults import SEATING_STIFFNESS
@@ -31,17 +30,14 @@ TIMES = [0.5, 1.0, 1.25, 1.5, 1.75, 2.0]
 def _model(q_max):
     scene = two_blocks(h1=0.5, h2=0.5, mesh_size=0.5, order=1)
     V = compat.vector_space(scene.mesh, 1)
-    clamp = fem.dirichletbc(np.zeros(3, dtype=PETSc.ScalarType), fem.locate_dofs_topological(
-        V, 2, scene.facet_tags.find(scene.tag("bottom"))), V)
-    law = SoftplusPenalty(k_normal=1e7, width=1e-9, k_tangential=1e7, friction=MU)
-    first, second = scene.contact_pair
-    ci = ContactInterface(V, scene.facet_tags, first, second, law=law, bcs=[clamp])
+    clamp, ci = clamped_pair(scene, V, SoftplusPenalty(k_normal=1e7, width=1e-9,
+                                                       k_tangential=1e7, friction=MU))
     top = scene.tag("top")
     problem = ContactProblem(
         V, Material(2e5, 0.3), [clamp],
         [SurfaceLoad(top, force=(0.0, 0.0, -P), channel="preload"),
          SurfaceLoad(top, force=(q_max, 0.0, 0.0), channel="shear")],
-        facet_tags=scene.facet_tags, interface=ci, seating_tag=first,
+        facet_tags=scene.facet_tags, interface=ci, seating_tag=ci.first_tag,
         seating_stiffness=SEATING_STIFFNESS,
         programs={"preload": lambda t: min(t, 1.0), "shear": lambda t: max(t - 1.0, 0.0)})
     return problem, SNESSolver(problem, prefix="fc_")

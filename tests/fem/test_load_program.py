@@ -17,20 +17,17 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from mpi4py import MPI
-from petsc4py import PETSc
 
 from dolfinx import fem
 from rough_contact.fem import compat
-from rough_contact.fem.contact import ContactInterface
-from rough_contact.fem.problem import (ContactProblem, Material, PrescribedDisplacement,
-                                       SurfaceLoad)
+from rough_contact.fem.problem import ContactProblem, Material, SurfaceLoad
 from rough_contact.interface.penalty import SoftplusPenalty
 from rough_contact.io.plotting import loop_energies
 from rough_contact.scenes.meshes.blocks import two_blocks
+from rough_contact.scenes.setup import clamped_pair, preload_then_drive
 from rough_contact.solver.loading import load_path
 from rough_contact.solver.program import cycle_index, cycle_summary, preload_then_cyclic
 from rough_contact.solver.snes import SNESSolver
-from rough_contact.scenes.defaults import SEATING_STIFFNESS
 
 MU, P, AMPLITUDE = 0.3, 100.0, 3e-3
 
@@ -38,20 +35,12 @@ MU, P, AMPLITUDE = 0.3, 100.0, 3e-3
 def _run(steps_per_cycle):
     scene = two_blocks(h1=0.5, h2=0.5, mesh_size=0.25, order=1)
     V = compat.vector_space(scene.mesh, 1)
-    clamp = fem.dirichletbc(np.zeros(3, dtype=PETSc.ScalarType), fem.locate_dofs_topological(
-        V, 2, scene.facet_tags.find(scene.tag("bottom"))), V)
-    law = SoftplusPenalty(k_normal=1e7, width=1e-9, k_tangential=1e7, friction=MU)
-    first, second = scene.contact_pair
-    ci = ContactInterface(V, scene.facet_tags, first, second, law=law, bcs=[clamp])
+    clamp, ci = clamped_pair(scene, V, SoftplusPenalty(k_normal=1e7, width=1e-9,
+                                                       k_tangential=1e7, friction=MU))
     top = scene.tag("top")
     program = preload_then_cyclic(preload_steps=2, cycles=2, steps_per_cycle=steps_per_cycle)
-    problem = ContactProblem(
-        V, Material(2e5, 0.3), [clamp], [SurfaceLoad(top, force=(0.0, 0.0, -P),
-                                                     channel="preload")],
-        facet_tags=scene.facet_tags, interface=ci, seating_tag=first,
-        seating_stiffness=SEATING_STIFFNESS,
-        prescribed=[PrescribedDisplacement(top, (AMPLITUDE, 0.0, 0.0), (0,), channel="cyclic")],
-        programs=program.channels)
+    problem = preload_then_drive(scene, V, Material(2e5, 0.3), clamp, ci, top, P, AMPLITUDE,
+                                 "cyclic", program.channels)
     solver = SNESSolver(problem, prefix="lp_")
     rows = []
     for inc in load_path(problem, solver, program.times, verbose=False):

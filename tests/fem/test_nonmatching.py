@@ -267,6 +267,31 @@ def _write_block_msh(path, z0, height, size, prefix, body_tag, tag0, order=1):
         gmsh.finalize()
 
 
+def _assert_parts_transmit_pressure(scene, order, prefix, p=80.0):
+    """The blocks of :func:`_write_block_msh` read as one scene, the upper one pressed by ``p``
+    on its top, both on rollers: the mortar pairing transmits ``p`` exactly (patch test)."""
+    V = compat.vector_space(scene.mesh, order)
+    bcs = [roller(V, scene, f"{b}_{s}", c) for b in ("lower", "upper")
+           for s, c in (("x0", 0), ("y0", 1))] + [roller(V, scene, "lower_bottom", 2)]
+    ci = ContactInterface(V, scene.facet_tags, *scene.contact_pair, law=LinearPenalty(1e6),
+                          bcs=bcs, pairing="mortar", quadrature_degree=2 * order)
+    mats = {scene.tag("upper"): Material(E, NU), scene.tag("lower"): Material(0.5 * E, NU)}
+    problem = ContactProblem(V, mats, bcs, [SurfaceLoad(scene.tag("upper_top"),
+                                                        traction=[0, 0, -p])],
+                             cell_tags=scene.cell_tags, facet_tags=scene.facet_tags,
+                             interface=ci)
+    solver = SNESSolver(problem, prefix=prefix)
+    problem.set_load_factor(1.0)
+    assert solver.solve().converged
+    ci.evaluate(problem.u)
+    pf = ci.point_fields()
+    real = pf.weight > 0
+    err = scene.mesh.comm.allreduce(float(np.abs(pf.pressure[real] - p).max(initial=0.0)),
+                                    op=MPI.MAX)
+    assert err <= 1e-8 * p
+    solver.destroy()
+
+
 def test_two_msh_files_make_one_scene(tmp_path):
     """Two blocks meshed in two .msh files (sizes 0.2 and 0.28) make one scene; the mortar
     pairing between them transmits a uniform pressure exactly (patch test)."""
@@ -281,25 +306,7 @@ def test_two_msh_files_make_one_scene(tmp_path):
     comm.Barrier()
     scene = scene_from_msh_files([lower, upper], comm,
                                  contact_pair=("upper_bottom", "lower_top"))
-    V = compat.vector_space(scene.mesh, 1)
-    bcs = [roller(V, scene, f"{b}_{s}", c) for b in ("lower", "upper")
-           for s, c in (("x0", 0), ("y0", 1))] + [roller(V, scene, "lower_bottom", 2)]
-    ci = ContactInterface(V, scene.facet_tags, *scene.contact_pair, law=LinearPenalty(1e6),
-                          bcs=bcs, pairing="mortar")
-    mats = {scene.tag("upper"): Material(E, NU), scene.tag("lower"): Material(0.5 * E, NU)}
-    problem = ContactProblem(V, mats, bcs, [SurfaceLoad(scene.tag("upper_top"),
-                                                        traction=[0, 0, -80.0])],
-                             cell_tags=scene.cell_tags, facet_tags=scene.facet_tags,
-                             interface=ci)
-    solver = SNESSolver(problem, prefix="test_msh_files_")
-    problem.set_load_factor(1.0)
-    assert solver.solve().converged
-    ci.evaluate(problem.u)
-    pf = ci.point_fields()
-    real = pf.weight > 0
-    err = comm.allreduce(float(np.abs(pf.pressure[real] - 80.0).max(initial=0.0)), op=MPI.MAX)
-    assert err <= 1e-8 * 80.0
-    solver.destroy()
+    _assert_parts_transmit_pressure(scene, 1, "test_msh_files_")
     with pytest.raises(ValueError, match="share physical group names"):
         scene_from_msh_files([lower, lower], comm, contact_pair=("lower_top", "lower_top"))
     with pytest.raises(ValueError, match="does not exist"):
@@ -333,25 +340,7 @@ def test_two_xdmf_files_make_one_scene(tmp_path, order):
     assert scene.order == order and set(scene.bodies) == {"lower", "upper"}
     for name, value in (("lower", 1.0), ("upper", 0.5), ("upper_bottom", 1.0), ("lower_x0", 1.0)):
         assert measure_of(scene, name) == pytest.approx(value, rel=1e-10), name
-    V = compat.vector_space(scene.mesh, order)
-    bcs = [roller(V, scene, f"{b}_{s}", c) for b in ("lower", "upper")
-           for s, c in (("x0", 0), ("y0", 1))] + [roller(V, scene, "lower_bottom", 2)]
-    ci = ContactInterface(V, scene.facet_tags, *scene.contact_pair, law=LinearPenalty(1e6),
-                          bcs=bcs, pairing="mortar", quadrature_degree=2 * order)
-    mats = {scene.tag("upper"): Material(E, NU), scene.tag("lower"): Material(0.5 * E, NU)}
-    problem = ContactProblem(V, mats, bcs, [SurfaceLoad(scene.tag("upper_top"),
-                                                        traction=[0, 0, -80.0])],
-                             cell_tags=scene.cell_tags, facet_tags=scene.facet_tags,
-                             interface=ci)
-    solver = SNESSolver(problem, prefix="test_xdmf_files_")
-    problem.set_load_factor(1.0)
-    assert solver.solve().converged
-    ci.evaluate(problem.u)
-    pf = ci.point_fields()
-    real = pf.weight > 0
-    err = comm.allreduce(float(np.abs(pf.pressure[real] - 80.0).max(initial=0.0)), op=MPI.MAX)
-    assert err <= 1e-8 * 80.0
-    solver.destroy()
+    _assert_parts_transmit_pressure(scene, order, "test_xdmf_files_")
     with pytest.raises(ValueError, match=r"tags \[1\d\] have no name|tags \[.*\] have no name"):
         scene_from_xdmf_files([(f"{folder}/upper.xdmf", {"upper": 1})], comm,
                               contact_pair=("upper", "upper"))

@@ -32,8 +32,8 @@ import numpy as np
 from mpi4py import MPI
 
 from rough_contact.fem.mesh import (Scene, add_groups, build_scene, entity_centers,
-                                    refine_towards, set_transfinite_hexahedra, validate_cell_type,
-                                    validate_order, validate_positive)
+                                    generate, refine_towards, set_transfinite_hexahedra,
+                                    validate_cell_type, validate_order, validate_positive)
 
 __all__ = ["beam_on_base"]
 
@@ -82,8 +82,6 @@ def beam_on_base(mesh_size: float = 20.0, contact_size: typing.Optional[float] =
     tol = 1e-6 * max(length, height)
 
     def build(model):
-        import gmsh
-
         occ = model.occ
         if cell_type == "hexahedron":  # two boxes, split under the load strip edge
             c = load_half_length
@@ -113,10 +111,7 @@ def beam_on_base(mesh_size: float = 20.0, contact_size: typing.Optional[float] =
                                       lambda p, axis: abs(p[2]) if axis == 2 else 0.0)
         else:
             refine_towards(model, "Abs(z)", contact_size, mesh_size, transition)
-        model.mesh.generate(3)
-        if order == 2:
-            gmsh.option.setNumber("Mesh.SecondOrderIncomplete", 0)
-            model.mesh.setOrder(2)
+        generate(model, order)
 
     return build_scene(
         comm, "beam_on_base", build, split_body="beam", contact_pair=("contact_beam", None),

@@ -38,8 +38,8 @@ import typing
 import numpy as np
 from mpi4py import MPI
 
-from rough_contact.fem.mesh import (Scene, add_groups, build_scene, entity_centers,
-                                    generate, refine_towards,
+from rough_contact.fem.mesh import (Scene, add_groups, build_contact_scene, build_scene,
+                                    entity_centers, generate, refine_towards,
                                     set_transfinite_hexahedra, validate_cell_type,
                                     validate_order, validate_positive)
 
@@ -55,6 +55,11 @@ def _side_groups(model, lx, ly, tol):
             "y1": (18, tags[np.abs(c[:, 1] - ly) < tol])}
 
 
+def _stacked_boxes(model, lx, ly, h1, h2):
+    """OCC boxes (lower, upper): [0, lx] x [0, ly] x [-h1, 0] and [0, lx] x [0, ly] x [0, h2]."""
+    return model.occ.addBox(0, 0, -h1, lx, ly, h1), model.occ.addBox(0, 0, 0, lx, ly, h2)
+
+
 def _mesh(model, mesh_size, order, cell_type):
     import gmsh
 
@@ -65,6 +70,24 @@ def _mesh(model, mesh_size, order, cell_type):
         gmsh.option.setNumber("Mesh.MeshSizeMax", mesh_size)
         gmsh.option.setNumber("Mesh.MeshSizeMin", 0.1 * mesh_size)
     generate(model, order)
+
+
+def _separate_hexahedra(model, faces: dict, sizes) -> None:
+    """Structured hexahedra on boxes meshed independently: ``sizes = ((volume, size), ...)``,
+    every curve of a volume's faces (``faces[volume]``) split into ``ceil(length / size)``
+    elements, then every surface and volume transfinite (recombined surfaces)."""
+    for vol, size in sizes:
+        edges = model.getBoundary([(2, f) for f in faces[vol]], combined=False, oriented=False)
+        for curve in sorted({abs(t) for _, t in edges}):
+            a, b = model.getBoundary([(1, curve)], combined=False, oriented=False)
+            length = np.linalg.norm(np.subtract(model.getValue(0, a[1], []),
+                                                model.getValue(0, b[1], [])))
+            model.mesh.setTransfiniteCurve(curve, 1 + max(1, int(np.ceil(length / size - 1e-9))))
+    for dim, surface in model.getEntities(2):
+        model.mesh.setTransfiniteSurface(surface)
+        model.mesh.setRecombine(dim, surface)
+    for _, volume in model.getEntities(3):
+        model.mesh.setTransfiniteVolume(volume)
 
 
 def two_blocks(lx: float = 1.0, ly: float = 1.0, h1: float = 1.0, h2: float = 1.0,
@@ -89,8 +112,7 @@ def two_blocks(lx: float = 1.0, ly: float = 1.0, h1: float = 1.0, h2: float = 1.
     validate_cell_type(cell_type)
     tol = 1e-6 * max(lx, ly, h1, h2)
     def build(model):
-        lower = model.occ.addBox(0, 0, -h1, lx, ly, h1)
-        upper = model.occ.addBox(0, 0, 0, lx, ly, h2)
+        lower, upper = _stacked_boxes(model, lx, ly, h1, h2)
         model.occ.fragment([(3, lower)], [(3, upper)])
         model.occ.synchronize()
         vols, vc = entity_centers(model, 3)
@@ -105,10 +127,8 @@ def two_blocks(lx: float = 1.0, ly: float = 1.0, h1: float = 1.0, h2: float = 1.
                               **_side_groups(model, lx, ly, tol)})
         _mesh(model, mesh_size, order, cell_type)
 
-    return build_scene(
-        comm, "two_blocks", build, split_body="upper",
-        contact_pair=("contact_upper", "contact_lower"),
-        surface_owners={"contact_upper": "upper", "contact_lower": "lower"},
+    return build_contact_scene(
+        comm, "two_blocks", build, ("upper", "lower"), ("contact_upper", "contact_lower"),
         dimensions=dict(lx=lx, ly=ly, h1=h1, h2=h2, mesh_size=mesh_size))
 
 
@@ -141,8 +161,7 @@ def separate_blocks(lx: float = 1.0, ly: float = 1.0, h1: float = 1.0, h2: float
     def build(model):
         import gmsh
 
-        lower = model.occ.addBox(0, 0, -h1, lx, ly, h1)
-        upper = model.occ.addBox(0, 0, 0, lx, ly, h2)
+        lower, upper = _stacked_boxes(model, lx, ly, h1, h2)
         model.occ.synchronize()   # no fragment: two independent surface meshes on z = 0
         add_groups(model, 3, {"upper": (1, [upper]), "lower": (2, [lower])})
         faces = {v: [t for _, t in model.getBoundary([(3, v)], oriented=False)]
@@ -156,34 +175,17 @@ def separate_blocks(lx: float = 1.0, ly: float = 1.0, h1: float = 1.0, h2: float
             "top": (13, tags[np.abs(z - h2) < tol]),
             "bottom": (14, tags[np.abs(z + h1) < tol]),
             **_side_groups(model, lx, ly, tol)})
-        for vol, size in ((lower, size_lower), (upper, size_upper)):
-            edges = model.getBoundary([(2, f) for f in faces[vol]], combined=False,
-                                      oriented=False)
-            curves = sorted({abs(t) for _, t in edges})
-            if cell_type == "hexahedron":
-                for curve in curves:
-                    a, b = model.getBoundary([(1, curve)], combined=False, oriented=False)
-                    length = np.linalg.norm(np.subtract(model.getValue(0, a[1], []),
-                                                        model.getValue(0, b[1], [])))
-                    model.mesh.setTransfiniteCurve(curve, 1 + max(1, int(np.ceil(
-                        length / size - 1e-9))))
-            else:
-                points = model.getBoundary([(3, vol)], recursive=True)
-                model.mesh.setSize(points, size)
+        sizes = ((lower, size_lower), (upper, size_upper))
         if cell_type == "hexahedron":
-            for dim, surface in model.getEntities(2):
-                model.mesh.setTransfiniteSurface(surface)
-                model.mesh.setRecombine(dim, surface)
-            for _, volume in model.getEntities(3):
-                model.mesh.setTransfiniteVolume(volume)
+            _separate_hexahedra(model, faces, sizes)
         else:
+            for vol, size in sizes:
+                model.mesh.setSize(model.getBoundary([(3, vol)], recursive=True), size)
             gmsh.option.setNumber("Mesh.MeshSizeMax", max(size_lower, size_upper))
         generate(model, order)
 
-    return build_scene(
-        comm, "separate_blocks", build, split_body="upper",
-        contact_pair=("contact_upper", "contact_lower"),
-        surface_owners={"contact_upper": "upper", "contact_lower": "lower"},
+    return build_contact_scene(
+        comm, "separate_blocks", build, ("upper", "lower"), ("contact_upper", "contact_lower"),
         dimensions=dict(lx=lx, ly=ly, h1=h1, h2=h2, size_lower=size_lower,
                         size_upper=size_upper))
 
@@ -229,26 +231,11 @@ def slider_on_slab(slab_length: float = 3.0, slider_length: float = 1.0, width: 
             "bottom": (14, pick(slab, np.abs(z + h_slab) < tol)),
             "y0_slider": (15, pick(slider, np.abs(y) < tol)),
             "y0_slab": (16, pick(slab, np.abs(y) < tol))})
-        for vol, size in ((slab, size_slab), (slider, size_slider)):
-            edges = model.getBoundary([(2, f) for f in faces[vol]], combined=False,
-                                      oriented=False)
-            for curve in sorted({abs(t) for _, t in edges}):
-                a, b = model.getBoundary([(1, curve)], combined=False, oriented=False)
-                length = np.linalg.norm(np.subtract(model.getValue(0, a[1], []),
-                                                    model.getValue(0, b[1], [])))
-                model.mesh.setTransfiniteCurve(curve, 1 + max(1, int(np.ceil(
-                    length / size - 1e-9))))
-        for dim, surface in model.getEntities(2):
-            model.mesh.setTransfiniteSurface(surface)
-            model.mesh.setRecombine(dim, surface)
-        for _, volume in model.getEntities(3):
-            model.mesh.setTransfiniteVolume(volume)
+        _separate_hexahedra(model, faces, ((slab, size_slab), (slider, size_slider)))
         generate(model, order)
 
-    return build_scene(
-        comm, "slider_on_slab", build, split_body="slider",
-        contact_pair=("contact_slider", "contact_slab"),
-        surface_owners={"contact_slider": "slider", "contact_slab": "slab"},
+    return build_contact_scene(
+        comm, "slider_on_slab", build, ("slider", "slab"), ("contact_slider", "contact_slab"),
         dimensions=dict(slab_length=slab_length, slider_length=slider_length, width=width,
                         h_slab=h_slab, h_slider=h_slider))
 
@@ -328,10 +315,8 @@ def sphere_on_block(radius: float = 10.0, cap_height: float = 1.0, half_width: f
                                 ([block], contact_size)])
         generate(model, order)
 
-    return build_scene(
-        comm, "sphere_on_block", build, split_body="sphere",
-        contact_pair=("sphere_contact", "block_contact"),
-        surface_owners={"sphere_contact": "sphere", "block_contact": "block"},
+    return build_contact_scene(
+        comm, "sphere_on_block", build, ("sphere", "block"), ("sphere_contact", "block_contact"),
         dimensions=dict(radius=radius, cap_height=cap_height, half_width=half_width,
                         height=height, contact_radius=contact_radius,
                         contact_size=contact_size, size_ratio=size_ratio))
@@ -387,10 +372,9 @@ def cylinder_on_block(radius: float = 5.0, height: float = 5.0, half_width: floa
         gmsh.option.setNumber("Mesh.MeshSizeMax", max(size_cylinder, size_block))
         generate(model, order)
 
-    return build_scene(
-        comm, "cylinder_on_block", build, split_body="cylinder",
-        contact_pair=("cylinder_contact", "block_contact"),
-        surface_owners={"cylinder_contact": "cylinder", "block_contact": "block"},
+    return build_contact_scene(
+        comm, "cylinder_on_block", build, ("cylinder", "block"),
+        ("cylinder_contact", "block_contact"),
         dimensions=dict(radius=radius, height=height, half_width=half_width,
                         block_height=block_height, size_cylinder=size_cylinder,
                         size_block=size_block))

@@ -35,9 +35,9 @@ import typing
 import numpy as np
 from mpi4py import MPI
 
-from rough_contact.fem.mesh import (Scene, add_groups, build_scene, entity_centers,
-                                    refine_towards, set_transfinite_hexahedra, validate_cell_type,
-                                    validate_order, validate_positive)
+from rough_contact.fem.mesh import (Scene, add_groups, build_contact_scene, entity_centers,
+                                    generate, refine_towards, set_transfinite_hexahedra,
+                                    validate_cell_type, validate_order, validate_positive)
 
 __all__ = ["flat_punch"]
 
@@ -99,8 +99,6 @@ def flat_punch(mesh_size: float = 10.0, contact_size: typing.Optional[float] = N
     tol = 1e-6 * max(L, H)
 
     def build(model):
-        import gmsh
-
         occ = model.occ
         if cell_type == "hexahedron":
             # boxes on the grid of break lines, so every volume is a 6-sided box
@@ -151,15 +149,10 @@ def flat_punch(mesh_size: float = 10.0, contact_size: typing.Optional[float] = N
             set_transfinite_hexahedra(model, contact_size, mesh_size, distance)
         else:
             _refinement_field(model, a, contact_size, mesh_size, transition)
-        model.mesh.generate(3)
-        if order == 2:
-            gmsh.option.setNumber("Mesh.SecondOrderIncomplete", 0)
-            model.mesh.setOrder(2)
+        generate(model, order)
 
-    return build_scene(
-        comm, "flat_punch", build, split_body="punch",
-        contact_pair=("contact_punch", "contact_foundation"),
-        surface_owners={"contact_punch": "punch", "contact_foundation": "foundation"},
+    return build_contact_scene(
+        comm, "flat_punch", build, ("punch", "foundation"), ("contact_punch", "contact_foundation"),
         dimensions=dict(half_width=a, punch_height=hp, foundation_half_width=L,
                         foundation_height=H, load_half_width=b, mesh_size=mesh_size,
                         contact_size=contact_size, transition=transition))
