@@ -576,7 +576,7 @@ class ContactProblem:
             if n == 0:
                 raise ValueError(f"PrescribedDisplacement(tag={p.tag}): no facet carries tag "
                                  f"{p.tag}; tags present: "
-                                 f"{sorted(set(np.concatenate(self.comm.allgather(np.unique(facet_tags.values)))))}")
+                                 f"{sorted({int(v) for v in np.concatenate(self.comm.allgather(np.unique(facet_tags.values)))})}")
             for c in p.components:
                 Vc, _ = self.V.sub(c).collapse()
                 dofs = fem.locate_dofs_topological((self.V.sub(c), Vc), fdim, facets)
