@@ -214,3 +214,20 @@ def test_demo_flat_punch_restart(tmp_path):
     assert "Nothing left to do" in again
     assert re.search(r"dissipation D: ([0-9.eE+-]+) N mm", again).group(1) == \
         re.search(pattern, full).group(1)
+
+
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_demo_fenicsx09_user(tmp_path, ranks):
+    """The FEniCSx 0.9 user's script (its own mesh, space, forms and boundary conditions, a
+    rough interface added, solved by the add-on's SNES driver and by the user's own Newton
+    loop): the two solves agree and the contact force balances the load (the demo asserts it).
+    Written in DOLFINx 0.9's spelling: on 0.5.2 it only says so."""
+    import dolfinx
+    if tuple(int(p) for p in dolfinx.__version__.split(".")[:2]) < (0, 8):
+        pytest.skip("demo_fenicsx09_user.py is written for DOLFINx 0.9 (Debian 13)")
+    if ranks > 1 and MPIRUN is None:
+        pytest.skip("mpirun not found")
+    out = run([DEMOS / "demo_fenicsx09_user.py", "--n", "3", "--out", tmp_path / "out"],
+              tmp_path, ranks)
+    assert "force balance" in out and "add-on vs own Newton" in out
+    assert (tmp_path / "out" / "displacement.bp").is_dir()

@@ -51,10 +51,11 @@ def test_own_loop_equals_load_path(enforcement):
     assert max(i.cutbacks for i in incs) == 0      # the doc's loop does not cut back
     own = _model(enforcement)
     dissipation = _own_loop()(own.problem, own.solver, factors)
-    # two builds in one process may be partitioned and numbered differently (round-off in the
-    # sums: 1.7e-12 seen on DOLFINx 0.9): compare norms of u to 1e-10
+    # two builds in one process may be partitioned and numbered differently (DOLFINx 0.9 even
+    # serially): round-off in the sums, 1.7e-12 in |u| and 4.8e-10 in the augmented run's small
+    # dissipation seen on 0.9 (0 on 0.5.2); both stay far below the penalty's own error
     np.testing.assert_allclose(_norms(own.problem), _norms(ref.problem), rtol=1e-10, atol=0)
-    np.testing.assert_allclose(dissipation, [i.dissipation for i in incs], rtol=1e-10, atol=0)
+    np.testing.assert_allclose(dissipation, [i.dissipation for i in incs], rtol=1e-8, atol=0)
     assert incs[-1].dissipation > 0.0      # friction worked: the check is not vacuous
     ref.solver.destroy()
     own.solver.destroy()
