@@ -21,9 +21,11 @@ rank, then ``meta.json``); the file ``LATEST`` naming the complete slot is repla
 moment leaves ``LATEST`` pointing at a complete slot.
 
 Refused with a clear error: a directory without a checkpoint, a different number of ranks,
-another mesh (DOF count or a checksum of the DOF coordinates differ), another partition (a rank
-holds other DOFs than when the checkpoint was written: DOLFINx's partitioner can give another
-partition for a second build of the same mesh in one process), another law
+another mesh (DOF count or a checksum of the DOF coordinates differ), another partition (no rank
+held this rank's DOFs, in this local order, when the checkpoint was written: DOLFINx's
+partitioner can give another partition for a second build of the same mesh in one process; the
+same parts handed to the ranks in another order, as DOLFINx 0.9 does between processes, are
+accepted: each rank reads the file of the rank that held its part), another law
 (type or number of interface points), or a load-factor list that does not match the saved one.
 """
 
@@ -109,9 +111,10 @@ def write_checkpoint(directory: str, problem, state: CheckpointState, sig: dict,
         pickle.dump(data, f, protocol=pickle.HIGHEST_PROTOCOL)
         f.flush()
         os.fsync(f.fileno())
+    partitions = comm.gather(data["partition"].tolist(), root=0)
     comm.Barrier()
     if comm.rank == 0:
-        meta = dict(signature=sig, step=state.step, index=state.index,
+        meta = dict(signature=sig, partitions=partitions, step=state.step, index=state.index,
                     delta=state.delta, cutbacks=state.cutbacks, load_factor=state.load_factor,
                     lam_previous=state.lam_previous, factors=list(map(float, state.factors)))
         with open(os.path.join(path, "meta.json"), "w") as f:
@@ -133,10 +136,29 @@ def has_checkpoint(directory: str, comm: MPI.Comm = MPI.COMM_WORLD) -> bool:
 
 
 def _local_checksum(problem) -> np.ndarray:
-    """(count, checksum) of this rank's owned DOF coordinates."""
-    x = problem.owned_dof_coordinates()
-    return np.array([float(x.shape[0]),
-                     float(np.round(x, 9).sum() + 7.0 * np.round(x ** 2, 9).sum())])
+    """(count, checksum, order checksum) of this rank's owned DOF coordinates and interface
+    points: which part of the mesh a rank holds, and in which local order."""
+    x = np.round(problem.owned_dof_coordinates(), 9)
+    ci = problem.interface
+    xp = np.zeros((0, 3)) if ci is None else np.round(ci.point_coordinates(), 9)
+    order = (np.arange(1, len(x) + 1) @ (x @ [1.0, 3.0, 7.0])
+             + np.arange(1, len(xp) + 1) @ (xp @ [1.0, 3.0, 7.0]))
+    return np.array([float(x.shape[0]), float(x.sum() + 7.0 * (x ** 2).sum()), float(order)])
+
+
+def _partition_source(comm, partitions, mine: np.ndarray) -> Optional[int]:
+    """The rank whose saved part equals this rank's (this rank itself if it does), or None
+    (no rank held it, or two ranks would read the same file); collective."""
+    if partitions is None or len(partitions) != comm.size:
+        return None
+    saved = [np.asarray(p, dtype=float) for p in partitions]
+    match = [r for r, p in enumerate(saved)
+             if p.shape == mine.shape and np.allclose(p, mine, rtol=1e-12, atol=1e-9)]
+    source = comm.rank if comm.rank in match else (match[0] if match else None)
+    sources = comm.allgather(source)
+    if source is not None and sources.count(source) > 1:
+        return None
+    return source
 
 
 def _latest(directory: str) -> Optional[str]:
@@ -182,14 +204,17 @@ def read_checkpoint(directory: str, problem, factors,
                               f"checkpointed run ({len(meta['factors'])}): resume with the same "
                               "load path")
     with open(os.path.join(path, f"rank{comm.rank}.pkl"), "rb") as f:
-        data = pickle.load(f)
-    # the same partition: every rank must hold the DOFs it held (a global checksum cannot see a
-    # permutation between ranks; DOLFINx's partitioner may differ between two mesh builds of one
-    # process)
-    mine_local = _local_checksum(problem)
-    same = (data["u"].shape == problem.local_solution_values().shape
-            and np.allclose(data.get("partition", mine_local), mine_local, rtol=1e-12,
-                            atol=1e-9))
+        own = pickle.load(f)
+    # the same partition: every rank must hold the DOFs (in the same local order) that some rank
+    # held when the checkpoint was written. DOLFINx 0.9 may hand the same parts to the ranks in
+    # another order in a fresh process: a rank then takes the data of the rank that held its
+    # part (the output writers' state stays with the rank); a different partition is refused.
+    source = _partition_source(comm, meta.get("partitions"), _local_checksum(problem))
+    data = own
+    if source is not None and source != comm.rank:
+        with open(os.path.join(path, f"rank{source}.pkl"), "rb") as f:
+            data = pickle.load(f)
+    same = source is not None and data["u"].shape == problem.local_solution_values().shape
     if not comm.allreduce(same, op=MPI.LAND):
         bad = comm.allgather(None if same else comm.rank)
         raise CheckpointError(
@@ -197,7 +222,7 @@ def read_checkpoint(directory: str, problem, factors,
             f"checkpointed run (rank(s) {[r for r in bad if r is not None]} hold other DOFs); "
             "build the mesh the same way on the same number of ranks (a fresh process building "
             "the same scenes in the same order does)")
-    saved_outputs = data.get("outputs", [])
+    saved_outputs = own.get("outputs", [])
     if len(saved_outputs) != len(outputs):
         raise CheckpointError(f"the checkpoint in {directory!r} holds the state of "
                               f"{len(saved_outputs)} output writer(s), {len(outputs)} were given: "

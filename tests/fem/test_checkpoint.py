@@ -200,7 +200,7 @@ def test_resume_refuses_another_partition(tmp_path, monkeypatch):
 
     def shifted(p):
         c = real(p)
-        return c + (comm.rank == comm.size - 1) * np.array([0.0, 1.0])
+        return c + (comm.rank == comm.size - 1) * np.array([0.0, 1.0, 0.0])
 
     monkeypatch.setattr(ck, "_local_checksum", shifted)
     problem, solver = _model()
