@@ -159,7 +159,7 @@ def spacing_from_coordinates(x, y, rtol: float = 1e-3) -> Tuple[float, float]:
             j = int(np.argmax(dev))
             raise ValueError(
                 f"non-uniform spacing along {name}: step {name}[{j + 1}] - {name}[{j}] = "
-                f"{d[j]!r} mm deviates by {dev[j]:.3g} (relative) from the mean step {step!r} "
+                f"{float(d[j])!r} mm deviates by {dev[j]:.3g} (relative) from the mean step {float(step)!r} "
                 f"mm; valid: strictly increasing, uniform to rtol = {rtol:g} (resample the map "
                 "onto a uniform grid)")
         out.append(step)
@@ -640,7 +640,7 @@ def _check_pressures(pressures, hardness) -> np.ndarray:
     if np.any(np.diff(p) <= 0):
         raise ValueError("pressures must be strictly increasing")
     if hardness is not None and p[-1] >= hardness:
-        raise ValueError(f"largest pressure = {p[-1]!r} MPa is invalid: it must be below the "
+        raise ValueError(f"largest pressure = {float(p[-1])!r} MPa is invalid: it must be below the "
                          f"hardness H = {hardness!r} MPa (p = H is full plastic contact)")
     return p
 

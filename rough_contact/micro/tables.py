@@ -393,7 +393,7 @@ def _adaptive_table(model: Model, h_lo: float, h_hi: float, rtol: float, n_initi
             j = int(np.flatnonzero(np.diff(q) > 0)[0])
             raise ValueError(
                 f"model pressure is not non-increasing: p({float(h[j])!r} mm) = {float(p[j])!r} MPa < "
-                f"p({h[j + 1]!r} mm) = {p[j + 1]!r} MPa")
+                f"p({float(h[j + 1])!r} mm) = {float(p[j + 1])!r} MPa")
         dla = limited_slopes(h, la)
         cq = hermite_coeffs(q[:-1], q[1:], dq[:-1], dq[1:], dxs)
         ca_ = hermite_coeffs(la[:-1], la[1:], dla[:-1], dla[1:], dxs)
@@ -578,15 +578,15 @@ def tabulate_data(h, p, a=None, k=None) -> Table:
                              "entries; valid: finite numbers")
     if np.any(np.diff(h) <= 0):
         j = int(np.flatnonzero(np.diff(h) <= 0)[0])
-        raise ValueError(f"table h must be strictly increasing: h[{j}] = {h[j]!r}, "
-                         f"h[{j + 1}] = {h[j + 1]!r} mm")
+        raise ValueError(f"table h must be strictly increasing: h[{j}] = {float(h[j])!r}, "
+                         f"h[{j + 1}] = {float(h[j + 1])!r} mm")
     if np.any(p <= 0):
         j = int(np.flatnonzero(p <= 0)[0])
         raise ValueError(f"table p[{j}] = {float(p[j])!r} MPa is outside the valid range (0, inf)")
     if np.any(np.diff(p) >= 0):
         j = int(np.flatnonzero(np.diff(p) >= 0)[0])
         raise ValueError(f"table p must be strictly decreasing in h: p[{j}] = {float(p[j])!r}, "
-                         f"p[{j + 1}] = {p[j + 1]!r} MPa")
+                         f"p[{j + 1}] = {float(p[j + 1])!r} MPa")
     q = np.log(p)
     if k is not None:
         k = np.array(k, dtype=float).ravel()
@@ -599,9 +599,9 @@ def tabulate_data(h, p, a=None, k=None) -> Table:
         if not mono.all():
             j = int(np.flatnonzero(~mono)[0])
             raise ValueError(
-                f"table k is inconsistent with p on [h[{j}], h[{j + 1}]] = [{h[j]!r}, "
-                f"{h[j + 1]!r}] mm: the Hermite interpolant of ln p would not be monotone "
-                f"(k = {k[j]!r}, {k[j + 1]!r} MPa/mm, secant "
+                f"table k is inconsistent with p on [h[{j}], h[{j + 1}]] = [{float(h[j])!r}, "
+                f"{float(h[j + 1])!r}] mm: the Hermite interpolant of ln p would not be monotone "
+                f"(k = {float(k[j])!r}, {float(k[j + 1])!r} MPa/mm, secant "
                 f"{-(p[j + 1] - p[j]) / dxs[j]!r} MPa/mm); tabulate more densely or omit k")
     else:
         dq = np.minimum(PchipInterpolator(h, q).derivative()(h), 0.0)
@@ -621,11 +621,11 @@ def tabulate_data(h, p, a=None, k=None) -> Table:
             raise ValueError(f"table a must have {h.size} finite entries, got {a.size}")
         if np.any((a <= 0) | (a > 1)):
             j = int(np.flatnonzero((a <= 0) | (a > 1))[0])
-            raise ValueError(f"table a[{j}] = {a[j]!r} is outside the valid range (0, 1]")
+            raise ValueError(f"table a[{j}] = {float(a[j])!r} is outside the valid range (0, 1]")
         if np.any(np.diff(a) > 0):
             j = int(np.flatnonzero(np.diff(a) > 0)[0])
-            raise ValueError(f"table a must be non-increasing in h: a[{j}] = {a[j]!r}, "
-                             f"a[{j + 1}] = {a[j + 1]!r}")
+            raise ValueError(f"table a must be non-increasing in h: a[{j}] = {float(a[j])!r}, "
+                             f"a[{j + 1}] = {float(a[j + 1])!r}")
         la = np.log(a)
         dla = np.minimum(PchipInterpolator(h, la).derivative()(h), 0.0)
     info = {"knots": h.size, "source": "table"}
@@ -654,7 +654,7 @@ def tabulate_population(fn, surface, param, rtol, area_limit, depth, tail, kwarg
     p_g, k_g, a_g = (np.asarray(v, float) for v in model(grid))
     if not (np.all(np.isfinite(a_g)) and np.all(np.isfinite(p_g))):
         raise ValueError(f"{name} model returned non-finite values on the range "
-                         f"[{grid[0]!r}, {grid[-1]!r}] mm")
+                         f"[{float(grid[0])!r}, {float(grid[-1])!r}] mm")
     # --- h_min: where A/A0 falls to area_limit, but not below -depth sigma
     above = a_g > area_limit
     if not above[0]:
@@ -662,7 +662,7 @@ def tabulate_population(fn, surface, param, rtol, area_limit, depth, tail, kwarg
     else:
         if above[-1]:
             raise ValueError(f"{name} model A/A0 stays above area_limit = {area_limit!r} up "
-                             f"to h = {grid[-1]!r} mm (12 sigma)")
+                             f"to h = {float(grid[-1])!r} mm (12 sigma)")
         j = int(np.flatnonzero(above)[-1])   # last grid point above the limit
         lo, hi = float(grid[j]), float(grid[j + 1])
         for _ in range(2):                    # bracket shrinks 8x per round
@@ -689,7 +689,7 @@ def tabulate_population(fn, surface, param, rtol, area_limit, depth, tail, kwarg
         # positive value if it is already small
         if pos.size == 0 or p_g[pos[-1]] > 1e-6 * p_ref:
             raise ValueError(f"{name} model pressure does not fall to tail = {tail!r} times "
-                             f"p_ref = {p_ref!r} MPa up to h = {grid[-1]!r} mm (40 sigma)")
+                             f"p_ref = {p_ref!r} MPa up to h = {float(grid[-1])!r} mm (40 sigma)")
         h_hi = float(grid[pos[-1]])
     n_scan = calls[0]
     remaining = max_seconds - (time.perf_counter() - t_start)

@@ -642,7 +642,7 @@ def _grid_axis(name: str, c: np.ndarray, path: Path) -> Tuple[np.ndarray, int, f
     """Indices of coordinates c on a uniform grid, the number of grid lines, start and step."""
     u = np.unique(c)
     if u.size < 2:
-        raise ValueError(f"{path}: all {name} coordinates are equal ({u[0]!r}): a 2D map needs "
+        raise ValueError(f"{path}: all {name} coordinates are equal ({float(u[0])!r}): a 2D map needs "
                          f">= {MIN_PIXELS} distinct values along each axis")
     steps = np.diff(u)
     step = float(np.median(steps))
@@ -654,7 +654,7 @@ def _grid_axis(name: str, c: np.ndarray, path: Path) -> Tuple[np.ndarray, int, f
         raise ValueError(
             f"{path}: the {name} coordinates are not uniformly spaced: steps between distinct "
             f"values range from {steps.min():.6g} to {steps.max():.6g} (median {step:.6g}), e.g. "
-            f"{u[j]!r} -> {u[j + 1]!r}; a uniform grid within {XYZ_GRID_TOL:g} of a step is "
+            f"{float(u[j])!r} -> {float(u[j + 1])!r}; a uniform grid within {XYZ_GRID_TOL:g} of a step is "
             "needed (resample the data first)")
     n = int(idx.max()) + 1
     # the step from the extreme coordinates: least affected by rounding in the file
