@@ -209,10 +209,12 @@ def create_mesh(comm, cells: np.ndarray, x: np.ndarray, cell_name: str, degree: 
         destinations = _slabs(cells, x)
     if destinations is None:
         return dolfinx.mesh.create_mesh(comm, cells, x, domain)
-    n_per_cell = cells.shape[1]
     if NEW_API:
+        # 0.9 hands the partitioner the cells' vertices only (the topology), not all nodes
+        n_vertices = 4 if cell_name == "tetrahedron" else 8
+
         def partitioner(comm_, nparts, cell_types, local_cells):
-            n = int(np.asarray(local_cells[0]).size // n_per_cell)
+            n = int(np.asarray(local_cells[0]).size // n_vertices)
             return dolfinx.graph.adjacencylist(
                 np.asarray(destinations(n, nparts), dtype=np.int32).reshape(-1, 1))
     else:
