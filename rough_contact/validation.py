@@ -25,8 +25,14 @@ def check_scalar(name: str, value, *, lo: Optional[float] = None, hi: Optional[f
         unit: unit shown after the value (e.g. ``"MPa"``).
 
     Raises:
-        ValueError: not a real number, not finite, or outside the range.
+        ValueError: not a real number (a string such as "2e5" included), not finite, or
+            outside the range.
     """
+    if isinstance(value, (str, bytes)):
+        # float("2e5") would pass the check, but the caller keeps the value it was given
+        # (frozen dataclasses) and fails later with a TypeError far from the input
+        raise ValueError(f"{name} = {value!r} is invalid: it must be a number, not a "
+                         f"{type(value).__name__}" + (f" (unit {unit})" if unit else ""))
     try:
         v = float(value)
     except (TypeError, ValueError):

@@ -252,6 +252,7 @@ class SNESSolver:
         self._k_norm_inf = problem.K.norm(PETSc.NormType.INFINITY)
         self._set_near_nullspace(near_nullspace)
         self._residuals: list = []
+        self._reported_after_first_solve = False
         self.snes.setMonitor(self._monitor)
 
     def _set_near_nullspace(self, near_nullspace) -> None:
@@ -337,6 +338,9 @@ class SNESSolver:
                 self.snes.setTolerances(atol=atol_before)
         reason = self.snes.getConvergedReason()
         self.problem.update_solution(self.x)
+        if not self._reported_after_first_solve:   # a typo shows now, not at the end of a run
+            self._reported_after_first_solve = True
+            self.report_unused_options()
         res = list(self._residuals)
         ok = reason > 0 and all(np.isfinite(res))
         return SolveResult(ok, int(reason), _reason_name(reason), self.snes.getIterationNumber(),
@@ -356,7 +360,7 @@ class SNESSolver:
     def report_unused_options(self) -> list[str]:
         """Warn (rank 0) about options under this solver's prefix that PETSc never read.
 
-        Call it at the end of a run: some options are read only at the first solve.
+        Called after the first solve (some options are read only then) and by :meth:`destroy`.
 
         Returns:
             The unused option names (without the dash) on this rank.

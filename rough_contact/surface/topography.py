@@ -574,18 +574,24 @@ def _delimiter(line: str) -> Optional[str]:
 def _read_table(path: Path, delimiter: Optional[str]):
     """Header ``# key = value`` pairs and the numeric table of a text file."""
     meta, first = {}, None
-    with open(path, encoding="utf-8") as f:
-        for line in f:
-            s = line.strip()
-            if not s:
-                continue
-            if s.startswith("#"):
-                key, sep, val = s[1:].partition("=")
-                if sep:
-                    meta[key.strip().lower()] = val.strip()
-                continue
-            first = s
-            break
+    try:
+        with open(path, encoding="utf-8") as f:
+            for line in f:
+                s = line.strip()
+                if not s:
+                    continue
+                if s.startswith("#"):
+                    key, sep, val = s[1:].partition("=")
+                    if sep:
+                        meta[key.strip().lower()] = val.strip()
+                    continue
+                first = s
+                break
+    except UnicodeDecodeError as e:
+        raise ValueError(f"{path} is not a text file (byte {e.start} is not UTF-8): a "
+                         f"'{path.suffix}' height map must be a text table; an "
+                         "instrument's binary file is read by read_instrument (through "
+                         "SurfaceTopography) under its own suffix") from None
     if first is None:
         raise ValueError(f"{path} holds no data lines")
     delim = _delimiter(first) if delimiter is None else delimiter

@@ -45,6 +45,8 @@ def test_demo_flat_punch(tmp_path, ranks):
                "-rc_snes_rtol", "1e-9"], tmp_path, ranks)
     assert "Force balance: max |Fz_contact + Fz_applied|" in out
     assert "Total frictional dissipation D" in out
+    # issue 24, item 13: the paper's Table 5 value is no longer printed as if it were the target
+    assert "not comparable with the paper's Table 5" in out and "docs/punch.md" in out
     assert (tmp_path / "punch" / "history.csv").exists()
 
 

@@ -445,3 +445,13 @@ def test_convergence_error_on_one_rank_cuts_back_on_every_rank(error):
     err = comm.allreduce(float(np.max(np.abs(pf.pressure - p), initial=0.0)), op=MPI.MAX)
     assert err <= 1e-8 * p
     solver.destroy()
+
+
+def test_material_given_a_string_is_refused_at_once():
+    """Issue 24, item 3: Material("2e5", 0.3) was accepted and failed later with a TypeError in
+    the Lame parameters; it is refused where it is made, naming E."""
+    with pytest.raises(ValueError, match=r"Young's modulus E = '2e5' is invalid: it must be a "
+                                         r"number, not a str"):
+        Material("2e5", 0.3)
+    with pytest.raises(ValueError, match=r"Poisson's ratio nu = '0.3' is invalid"):
+        Material(2e5, "0.3")

@@ -234,3 +234,26 @@ def test_bad_solver_choices():
     with pytest.raises(ValueError, match="near_nullspace = 'local' is invalid"):
         SNESSolver(problem, prefix="bad2_", linear_solver="gamg", near_nullspace="local")
 
+
+
+def test_unused_option_is_reported_after_the_first_solve():
+    """Issue 24, item 14: a mistyped option was reported only when the solver was destroyed at
+    the end of a (long) run; it is reported right after the first solve (rank 0)."""
+    PETSc.Options().setValue("early_snes_monitr", "")
+    problem = bulk_problem(10.0)
+    solver = SNESSolver(problem, prefix="early_")
+    problem.set_load_factor(1.0)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        assert solver.solve().converged
+    mine = [w for w in caught if issubclass(w.category, UnusedOptionsWarning)]
+    if problem.comm.rank == 0:
+        assert len(mine) == 1 and "-early_snes_monitr" in str(mine[0].message)
+    else:
+        assert mine == []
+    with warnings.catch_warnings(record=True) as caught:   # the second solve stays quiet
+        warnings.simplefilter("always")
+        assert solver.solve().converged
+    assert not [w for w in caught if issubclass(w.category, UnusedOptionsWarning)]
+    PETSc.Options().delValue("early_snes_monitr")
+    solver.destroy()

@@ -321,3 +321,14 @@ def test_bad_inputs_give_clear_errors(tmp_path, table1_map):
 
 def test_topography_is_a_pure_layer(imports_without):
     imports_without(["rough_contact.surface.topography"], also={"SurfaceTopography"})
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".xyz"])
+def test_binary_file_with_a_text_suffix_names_the_file(tmp_path, suffix):
+    """Issue 24, item 4: a binary file named .csv raised a raw UnicodeDecodeError without the
+    file name; now a ValueError names the file and the cause."""
+    from rough_contact.surface.topography import read_height_map
+    path = tmp_path / f"scan{suffix}"
+    path.write_bytes(bytes(range(128, 256)) * 8)
+    with pytest.raises(ValueError, match=rf"scan\{suffix} is not a text file"):
+        read_height_map(path, dx=1e-3, dy=1e-3) if suffix == ".csv" else read_height_map(path)
