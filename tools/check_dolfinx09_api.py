@@ -5,14 +5,14 @@ what the library needs from it (shapes, values, parallel consistency). Run insid
 chroot, serially and on 2 ranks:
 
     bash run.sh debian13 python tools/check_dolfinx09_api.py
-    bash run.sh debian13 python -m mpi4py tools/check_dolfinx09_api.py   # under mpirun -n 2:
-    bash run.sh debian13 shell <<< 'cd /work/rough_contact && mpirun -n 2 \
-        /opt/rough_contact/venv/bin/python tools/check_dolfinx09_api.py'
+    bash run.sh debian13 shell <<< 'mpirun -n 2 "$RC_VENV/bin/python" tools/check_dolfinx09_api.py'
+
+(the chroot's shell starts in the repository and sets RC_VENV to its virtual environment).
 
 Prints one markdown row per check (0.5.2 call | 0.9 call | verified) on rank 0; a check is
 "yes" only when it passed on every rank. ``--json PATH`` writes the results as well. Exit code
-1 if any check failed. Documented in docs/dolfinx09_port.md. Not part of the test suite: the
-library itself still targets 0.5.2 until the port.
+1 if any check failed. Documented in docs/dolfinx09_port.md. Not part of the test suite (the
+suite itself runs on 0.9: `bash run.sh test-debian13`).
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """The package's layers, read from its source (no dolfinx needed).
 
-Layers, bottom to top (docs: /work/shared/STYLE.md section 1): the pure layers (validation,
+Layers, bottom to top (README, "Layout"; docs/design.md): the pure layers (validation,
 rough surfaces and the micro-model, ``interface``) < ``fem`` (the only layer importing dolfinx,
 ufl, basix; with the mesh builders) < ``solver`` < ``io`` < ``scenes``.
 
