@@ -284,8 +284,9 @@ class ContactInterface(InterfaceQueries):
         return changed
 
     def _use_partners(self, partners) -> bool:
-        moved = self.comm.allreduce(int(np.any(partners.facet.reshape(-1) !=
-                                               self._partner_facet())), op=MPI.SUM)
+        before = self.paired.partners.facet.reshape(-1)
+        moved = self.comm.allreduce(int(np.any(partners.facet.reshape(-1) != before)),
+                                    op=MPI.SUM)
         self.paired = replace(self.paired, partners=partners)
         global_dofs, bcs = self._dirichlet
         self._set_operator(JumpOperator(self.V, self.paired, bcs=bcs, global_dofs=global_dofs),
@@ -296,9 +297,6 @@ class ContactInterface(InterfaceQueries):
         # assembles into the same pattern as the uninterrupted one, bit for bit
         changed = {tuple(k) for k in self.keys.tolist()} != self._matrix_keys
         return bool(self.comm.allreduce(changed, op=MPI.LOR))
-
-    def _partner_facet(self) -> np.ndarray:
-        return self.paired.partners.facet.reshape(-1)
 
     def predict(self, ratio: float) -> bool:
         """Secant predictor of the multipliers, lambda_n + ratio (lambda_n - lambda_{n-1})

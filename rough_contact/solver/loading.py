@@ -313,8 +313,7 @@ class _Stepper:
         self.min_increment, self.max_growth = min_increment, max_growth
         self.verbose, self.validity = verbose, validity
         self.predictor, self.friction_check = predictor, friction_check
-        self.u_committed = None
-        self.lam_committed = problem.load_factor
+        self.u_committed = self.lam_committed = None     # set by run (after a resume)
         self.u_previous, self.lam_previous = None, None  # the converged state before u_committed
         self.step = 0
         self.spent = [0, 0, 0]  # Newton its, linear its, failed attempts since the last step

@@ -24,7 +24,6 @@ from typing import Optional, Protocol, runtime_checkable
 import numpy as np
 from mpi4py import MPI
 
-from rough_contact.fem import compat
 from rough_contact.fem.pairing.facets import FacetGeometry, FacetRule, cmap_element
 
 __all__ = ["SurfaceContext", "Partners", "PairedPoints", "Pairing", "SlidingPairing",
@@ -213,8 +212,3 @@ def local_frames(comm, xq: np.ndarray, normal: np.ndarray, grain: np.ndarray,
     R = np.stack([normal, ex, ey], axis=-2)
     return R.reshape(-1, 3, 3), jump0.reshape(-1, 3)
 
-
-def element_degree_matches_geometry(V) -> bool:
-    """Whether the displacement space has the geometry's degree (needed to move the surfaces
-    with the displacement exactly)."""
-    return compat.element_degree(V) == compat.geometry_degree(V.mesh)
