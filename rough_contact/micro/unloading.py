@@ -95,8 +95,10 @@ def ekk_residual_ratio(omega_max_star):
     The Etsion-Kligerman-Kadin (2005) fit in the form
     1.02 [1 - (w* + 5.9)^(-0.54)] [1 - (w*)^(-0.14)] for w* >= 1 (0 below), stated by its
     authors for 1 <= w* <= 110 (their loading law: Kogut-Etsion, elastic-linear-hardening FE).
-    The coefficients are quoted from memory of the paper and could not be checked against its
-    text here: treat this option as provisional (see docs/unloading.md).
+    The coefficients are the form as recalled: the paper's text could not be retrieved to check
+    them (docs/unloading.md says what was checked and what is uncertain); the option is
+    provisional. Elliptic summits: w* uses the summit's own omega_c, and the ratio is taken as
+    the sphere's at the same w* (reading stated in docs/unloading.md).
     """
     w = np.asarray(omega_max_star, dtype=float)
     ws = np.maximum(w, 1.0)
