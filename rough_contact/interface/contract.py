@@ -124,6 +124,10 @@ class LawResult:
             is valid for (e.g. a statistical normal law below its lowest tabulated separation,
             where a stiff continuation stands in for the model); ``None`` for a law without
             such a limit. The load stepping reports these points per increment.
+        normal_dissipation: (n,) float normal hysteresis energy of this step per nominal area
+            [N/mm] (>= 0), for a law with an irreversible normal part
+            (``rough_contact.interface.history``); ``None`` for a reversible normal law. The
+            owner of the history sums it beside the frictional ``dissipation``.
     """
 
     traction: np.ndarray
@@ -134,6 +138,7 @@ class LawResult:
     contact: np.ndarray
     slipping: np.ndarray
     beyond_validity: Optional[np.ndarray] = None
+    normal_dissipation: Optional[np.ndarray] = None
 
     @property
     def pressure(self) -> np.ndarray:
@@ -153,6 +158,8 @@ class LawResult:
         kind_names = {np.floating: "a floating-point dtype", np.bool_: "bool"}
         if self.beyond_validity is not None:
             fields += (("beyond_validity", (n,), np.bool_),)
+        if self.normal_dissipation is not None:
+            fields += (("normal_dissipation", (n,), np.floating),)
         for name, shape, kind in fields:
             value = getattr(self, name)
             if not isinstance(value, np.ndarray):

@@ -26,7 +26,8 @@ import numpy as np
 from ..validation import check_scalar
 from .contract import LawResult, check_jump
 from .friction import FrictionInput, IsotropicSlipHardening, OrthotropicSlipHardening
-from .state import InterfaceState
+from .history import HistoryNormalLawProtocol
+from .state import HistoryInterfaceState, InterfaceState
 from .tangential import TangentialStiffness
 
 __all__ = ["InterfaceLaw", "NormalLawProtocol", "SeatableNormalLaw", "ValidityLimitedNormalLaw"]
@@ -90,6 +91,14 @@ class InterfaceLaw:
             frictionless (t_T = 0, no history).
         h0: reference mean-plane separation [mm] at zero gap (h = h0 + g); set it directly or
             with ``with_seating``.
+
+    Normal memory (the irreversible knob): a normal law that implements
+    ``rough_contact.interface.history.HistoryNormalLawProtocol`` (e.g. ``HistoryNormalLaw``)
+    makes the state a ``HistoryInterfaceState`` whose h_min (the smallest separation reached)
+    is committed and reverted with the slip history; p, kN, A/A0 then follow the loading branch
+    where h <= h_min and the elastic unloading/reloading branch of h_min elsewhere, and
+    ``LawResult.normal_dissipation`` is the normal hysteresis energy of the step. A plain
+    ``NormalLaw`` (e.g. the elasto-plastic one, the default) stays reversible.
     """
 
     normal: NormalLawProtocol
@@ -134,9 +143,24 @@ class InterfaceLaw:
         h0 = float(np.asarray(self.normal.separation_for_pressure(np.array([p]))).reshape(-1)[0])
         return dataclasses.replace(self, h0=h0)
 
+    @property
+    def has_normal_memory(self) -> bool:
+        """True when the normal law keeps a history (``HistoryNormalLawProtocol``)."""
+        return isinstance(self.normal, HistoryNormalLawProtocol)
+
     def initial_state(self, n_pts: int) -> InterfaceState:
-        """Virgin history at n_pts points."""
+        """Virgin history at n_pts points (a ``HistoryInterfaceState`` with h_min = +inf when
+        the normal law has memory)."""
+        if self.has_normal_memory:
+            return HistoryInterfaceState.zeros(n_pts)
         return InterfaceState.zeros(n_pts)
+
+    def normal_dissipated(self, state: InterfaceState) -> np.ndarray:
+        """(n,) normal hysteresis energy per nominal area dissipated since the virgin state
+        [N/mm]: D(h_min) of the state's h_min (zeros for a reversible normal law)."""
+        if not self.has_normal_memory:
+            return np.zeros(len(state))
+        return np.asarray(self.normal.normal_dissipation(state.h_min), dtype=float)
 
     def evaluate(self, jump: np.ndarray, committed: InterfaceState) -> LawResult:
         """Traction, consistent tangent and trial state at jump (n, 3) [mm]; never mutates input.
@@ -165,10 +189,27 @@ class InterfaceLaw:
         h = self.h0 + jump[:, 0]
         traction = np.zeros((n, 3))
         tangent = np.zeros((n, 3, 3))  # zero rows 1-2 at open points; row 0 = [k, 0, 0]
-        if self.friction is None:
-            p, k, a = self.normal.evaluate(h, curvature=False)
+        curv = self.friction is not None
+        normal_dissipation = None
+        if self.has_normal_memory:
+            if not isinstance(committed, HistoryInterfaceState):
+                raise ValueError("committed state must be a HistoryInterfaceState (h_min) for a "
+                                 f"normal law with memory, got {type(committed).__name__}: use "
+                                 "initial_state()")
+            out = self.normal.evaluate_history(h, committed.h_min, curvature=curv)
+            h_min_new = np.minimum(committed.h_min, h)
+            normal_dissipation = np.zeros(n)
+            moved = np.flatnonzero(h_min_new < committed.h_min)
+            if moved.size:
+                D = self.normal.normal_dissipation
+                normal_dissipation[moved] = np.maximum(
+                    D(h_min_new[moved]) - D(committed.h_min[moved]), 0.0)
         else:
-            p, k, a, dk = self.normal.evaluate(h, curvature=True)
+            out = self.normal.evaluate(h, curvature=curv)
+        if curv:
+            p, k, a, dk = out
+        else:
+            p, k, a = out
         traction[:, 0] = -p
         tangent[:, 0, 0] = k
         contact = p > 0.0
@@ -177,8 +218,11 @@ class InterfaceLaw:
         slipping = np.zeros(n, dtype=bool)
         dissipation = np.zeros(n)
         if self.friction is None or not contact.any():
-            return LawResult(traction, tangent, committed.copy(), dissipation, a, contact,
-                             slipping, beyond)
+            state = committed.copy()
+            if normal_dissipation is not None:
+                state.h_min = h_min_new
+            return LawResult(traction, tangent, state, dissipation, a, contact,
+                             slipping, beyond, normal_dissipation)
 
         cx, cy = self.tangential.kt_over_kn
         sp = committed.plastic_slip
@@ -211,4 +255,7 @@ class InterfaceLaw:
             state.slip_path[pts] += slip.path_increment
             dissipation[pts] = dw
             slipping[pts] = True
-        return LawResult(traction, tangent, state, dissipation, a, contact, slipping, beyond)
+        if normal_dissipation is not None:
+            state.h_min = h_min_new
+        return LawResult(traction, tangent, state, dissipation, a, contact, slipping, beyond,
+                         normal_dissipation)

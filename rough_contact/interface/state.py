@@ -17,7 +17,7 @@ import numpy as np
 
 from .contract import LawResult, LawState
 
-__all__ = ["InterfaceState", "StatePair", "InterfaceHistory"]
+__all__ = ["InterfaceState", "HistoryInterfaceState", "StatePair", "InterfaceHistory"]
 
 
 @dataclass
@@ -62,6 +62,37 @@ class InterfaceState:
         return self.plastic_slip.shape[0]
 
 
+@dataclass
+class HistoryInterfaceState(InterfaceState):
+    """``InterfaceState`` plus the normal history of an irreversible normal law
+    (``rough_contact.interface.history.HistoryNormalLawProtocol``).
+
+    Attributes:
+        h_min: (n,) smallest mean-plane separation reached so far [mm]; +inf for a virgin point.
+    """
+
+    h_min: np.ndarray = None
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        n = self.plastic_slip.shape[0]
+        if not isinstance(self.h_min, np.ndarray) or self.h_min.shape != (n,):
+            raise ValueError(f"HistoryInterfaceState.h_min must be an ndarray of shape ({n},), "
+                             f"got {np.shape(self.h_min)}")
+
+    @classmethod
+    def zeros(cls, n_pts: int) -> HistoryInterfaceState:
+        """Virgin state at n_pts points (no slip, h_min = +inf)."""
+        base = InterfaceState.zeros(n_pts)
+        return cls(base.plastic_slip, base.accumulated_slip, base.slip_path,
+                   np.full(base.slip_path.shape, np.inf))
+
+    def copy(self) -> HistoryInterfaceState:
+        """Deep copy."""
+        return HistoryInterfaceState(self.plastic_slip.copy(), self.accumulated_slip.copy(),
+                                     self.slip_path.copy(), self.h_min.copy())
+
+
 class StatePair:
     """Committed and trial history of one interface, and the dissipation accumulated over it.
 
@@ -75,6 +106,9 @@ class StatePair:
         committed: state at the last converged increment.
         trial: state of the latest law evaluation.
         dissipated: (n,) dissipation per nominal area summed over committed increments [N/mm].
+        normal_dissipated: (n,) normal hysteresis energy per nominal area (irreversible normal
+            law, ``LawResult.normal_dissipation``) summed over committed increments [N/mm];
+            zeros for a reversible law.
     """
 
     def __init__(self, committed: LawState):
@@ -86,6 +120,8 @@ class StatePair:
         n = len(committed)
         self.dissipated = np.zeros(n)
         self._pending = np.zeros(n)
+        self.normal_dissipated = np.zeros(n)
+        self._pending_normal = np.zeros(n)
 
     def update(self, result: LawResult) -> None:
         """Keep the trial state and dissipation increment of a law evaluation.
@@ -104,14 +140,19 @@ class StatePair:
                              f"{np.shape(result.dissipation)}; committed has {n} points")
         self.trial = result.state
         self._pending = result.dissipation
+        self._pending_normal = (np.zeros(n) if result.normal_dissipation is None
+                                else result.normal_dissipation)
 
     def commit(self) -> None:
         """Accept the trial state and its dissipation (after the global Newton converged)."""
         self.committed = self.trial.copy()
         self.dissipated = self.dissipated + self._pending
         self._pending = np.zeros_like(self.dissipated)
+        self.normal_dissipated = self.normal_dissipated + self._pending_normal
+        self._pending_normal = np.zeros_like(self.dissipated)
 
-    def restore(self, committed: LawState, dissipated: np.ndarray) -> None:
+    def restore(self, committed: LawState, dissipated: np.ndarray,
+                normal_dissipated: Optional[np.ndarray] = None) -> None:
         """Set the committed state and the accumulated dissipation, dropping the trial
         (resuming a checkpoint)."""
         if not isinstance(committed, LawState) or len(committed) != len(self.committed):
@@ -126,11 +167,19 @@ class StatePair:
         self.trial = committed.copy()
         self.dissipated = d.copy()
         self._pending = np.zeros_like(self.dissipated)
+        nd = (np.zeros_like(d) if normal_dissipated is None
+              else np.asarray(normal_dissipated, dtype=float))
+        if nd.shape != d.shape:
+            raise ValueError(f"restored normal dissipation of shape {nd.shape}, expected "
+                             f"{d.shape}")
+        self.normal_dissipated = nd.copy()
+        self._pending_normal = np.zeros_like(self.dissipated)
 
     def revert(self) -> None:
         """Discard the trial state and its dissipation (the global Newton failed; cutback)."""
         self.trial = self.committed.copy()
         self._pending = np.zeros_like(self.dissipated)
+        self._pending_normal = np.zeros_like(self.dissipated)
 
 
 class InterfaceHistory:
@@ -204,7 +253,7 @@ class InterfaceHistory:
     def state(self) -> dict:
         """The committed history as one picklable dict (for checkpoints)."""
         return dict(committed=self.law.committed, dissipated=self.law.dissipated,
-                    multipliers=self.multipliers, multipliers_before=self.multipliers_before,
+                    normal_dissipated=self.law.normal_dissipated, multipliers=self.multipliers, multipliers_before=self.multipliers_before,
                     pairing=self.pairing)
 
     def restore(self, state: dict) -> None:
@@ -213,7 +262,8 @@ class InterfaceHistory:
         Raises:
             ValueError: the state belongs to another interface (point count, multipliers).
         """
-        self.law.restore(state["committed"], state["dissipated"])
+        self.law.restore(state["committed"], state["dissipated"],
+                         state.get("normal_dissipated"))
         lam, before = state["multipliers"], state["multipliers_before"]
         for name, value in (("multipliers", lam), ("multipliers_before", before)):
             if value is not None and (self.multipliers is None

@@ -41,18 +41,14 @@ population stiffness MPa/mm. Surface moments as ``SpectralMoments`` (um conventi
 from __future__ import annotations
 
 import math
-import time
-from dataclasses import dataclass, field
-
 import numpy as np
 
 from . import population as _pop
 from .asperity import (AsperityMaterial, critical_interference, shape_factors, zmc_area,
                        zmc_mean_pressure)
-from ..validation import check_scalar
 
 __all__ = ["summit_loading", "recovered_interference", "summit_unloading", "ekk_residual_ratio",
-           "population_unloading", "HistoryNormalLaw"]
+           "population_unloading"]
 
 _RESIDUAL = ("consistent", "ekk")
 
@@ -210,7 +206,7 @@ def _invert_delta_e(tau, tc, tp, kappa, f1, f2, f3, wc, wp, mat, smu, n_iter=48)
 
 
 def _row_sums(surface, mat, h_min, u, n_quad, n_t):
-    """p, k, a at (h_min + u, h_min) for one h_min [mm] and an array u >= 0 [mm]."""
+    """p, k, a, -da/dh at (h_min + u, h_min) for one h_min [mm] and an array u >= 0 [mm]."""
     smu = math.sqrt(surface.m00 * surface.mu)
     l = np.array([h_min / smu])
     r4, r6, d, logw = _pop._outer_nodes(surface, l, n_quad, n_quad)
@@ -230,7 +226,7 @@ def _row_sums(surface, mat, h_min, u, n_quad, n_t):
     tpk = -dd
     t2 = _invert_delta_e(tau, tc, tp, kappa, f1, f2, f3, wc, wp, mat, smu)
     x, w = _pop._gl01(n_t)
-    out = [np.zeros(tau.shape[0]) for _ in range(3)]
+    out = [np.zeros(tau.shape[0]) for _ in range(4)]
     # panels: (start of sqrt substitution, panel lower, panel upper)
     panels = [(tau, np.maximum(tau, t_lo), np.minimum(tc, t_hi)),            # elastic summits
               (t2, np.maximum(t2, t_lo), np.minimum(tp, t_hi)),              # ZMC
@@ -254,8 +250,10 @@ def _row_sums(surface, mat, h_min, u, n_quad, n_t):
                 out[0] += np.sum(g * P * xi ** 1.5, axis=1)
                 out[1] += np.sum(g * kk, axis=1)
                 out[2] += np.sum(g * A * xi, axis=1)
+                with np.errstate(divide="ignore", invalid="ignore"):
+                    out[3] += np.sum(g * np.where((xi > 0) & (de > 0), A / de, 0.0), axis=1)
     Ds = surface.summit_density
-    return out[0] * Ds, out[1] * Ds, out[2] * Ds
+    return out[0] * Ds, out[1] * Ds, out[2] * Ds, out[3] * Ds
 
 
 def population_unloading(surface, material: AsperityMaterial, h, h_min, n_quad: int = 12,
@@ -278,269 +276,11 @@ def population_unloading(surface, material: AsperityMaterial, h, h_min, n_quad: 
         idx = np.flatnonzero(~lower)
         for c in range(0, idx.size, 64):
             sl = idx[c:c + 64]
-            vals = _row_sums(surface, mat, hm, u[sl], n_quad, n_t)
+            vals = _row_sums(surface, mat, hm, u[sl], n_quad, n_t)[:3]
             for r, v in zip(res, vals):
                 r[sl] = v
     for i in np.flatnonzero(lower):
-        vals = _row_sums(surface, mat, h[i], np.zeros(1), n_quad, n_t)
+        vals = _row_sums(surface, mat, h[i], np.zeros(1), n_quad, n_t)[:3]
         for r, v in zip(res, vals):
             r[i] = v[0]
     return tuple(r.reshape(np.shape(h)) for r in res)
-
-
-# ---------------------------------------------------------------------------------------------
-# the tabulated law
-# ---------------------------------------------------------------------------------------------
-def _h_basis(t):
-    """Cubic Hermite basis (h00, h01, h10, h11) and their t-derivatives."""
-    t2, t3 = t * t, t * t * t
-    H = (2 * t3 - 3 * t2 + 1, -2 * t3 + 3 * t2, t3 - 2 * t2 + t, t3 - t2)
-    dH = (6 * t2 - 6 * t, -6 * t2 + 6 * t, 3 * t2 - 4 * t + 1, 3 * t2 - 2 * t)
-    return H, dH
-
-
-def _fd_rows(v, dx):
-    """d v/d x along axis 0 on a uniform grid: central, one-sided 3-point at the ends."""
-    d = np.empty_like(v)
-    d[1:-1] = (v[2:] - v[:-2]) / (2 * dx)
-    if v.shape[0] >= 3:
-        d[0] = (-3 * v[0] + 4 * v[1] - v[2]) / (2 * dx)
-        d[-1] = (3 * v[-1] - 4 * v[-2] + v[-3]) / (2 * dx)
-    else:
-        d[0] = d[-1] = (v[-1] - v[0]) / dx
-    return d
-
-
-@dataclass(frozen=True, eq=False)
-class HistoryNormalLaw:
-    """Irreversible normal law p(h, h_min), k(h, h_min) = -dp/dh, A/A0(h, h_min).
-
-    Build with :meth:`elasto_plastic` (table, see docs/unloading.md) or :meth:`elastic`
-    (exactly reversible: the loading ``NormalLaw`` itself, h_min ignored).
-
-    Table (elasto-plastic): the loading branch is a ``NormalLaw`` (``loading``); the unloading
-    branch is stored as rho(h_min, s) = ln p(h, h_min) - ln p(h_min, h_min) with
-    s = (h - h_min)/(h_end - h_min) in [0, 1] (h_end = loading.h_table_end), as a bicubic
-    Hermite surface on a uniform h_min grid x an adaptive s grid: s-slopes are the model's
-    stiffness (d rho/ds = -k/p (h_end - h_min)), h_min-slopes finite differences. k is the
-    exact s-derivative of the interpolant (consistent tangent at fixed h_min). ln(A/A0) is
-    interpolated the same way with finite-difference s-slopes. Beyond s = 1 the cubic taper
-    of ``NormalLaw``; h_min above h_end: reversible (nothing is plastic there); h_min below the
-    loading table (the penalty continuation): the unloading shape of the first row.
-    """
-
-    loading: object
-    rtol: float | None
-    _hm: np.ndarray | None = None       # (n_m,) uniform h_min knots [mm]
-    _s: np.ndarray | None = None        # (n_s,) s knots
-    _R: tuple | None = None             # (rho, rho_s, rho_m, rho_ms) each (n_m, n_s)
-    _RA: tuple | None = None            # same for ln(a) - ln(a0)
-    info: dict = field(default_factory=dict)
-
-    # ------------------------------------------------------------ constructors
-    @classmethod
-    def elastic(cls, surface, E_star: float, rtol: float = 1e-4, **kwargs) -> "HistoryNormalLaw":
-        """Elastic population: the reversible ``NormalLaw.elastic`` (h_min has no effect)."""
-        from .interface.normal import NormalLaw
-        t0 = time.perf_counter()
-        law = NormalLaw.elastic(surface, E_star, rtol, **kwargs)
-        return cls(loading=law, rtol=rtol, info={"build_seconds": time.perf_counter() - t0,
-                                                  "reversible": True})
-
-    @classmethod
-    def elasto_plastic(cls, surface, material: AsperityMaterial, rtol: float = 1e-4, *,
-                       loading=None, n_quad: int = 16, n_t: int = 16, n_rows: int = 8,
-                       n_s: int = 8, floor: float = 1e-8, max_rounds: int = 12,
-                       max_seconds: float = 600.0, strict: bool = True) -> "HistoryNormalLaw":
-        """Table of the elasto-plastic population with memory (reading "consistent").
-
-        Args:
-            surface: SpectralMoments; material: AsperityMaterial (psi resolved on surface).
-            rtol: relative accuracy of p, k, A/A0 of the unloading branch against the direct
-                sums (:func:`population_unloading` with the same n_quad, n_t) at the check
-                points (s-midpoints of knot rows, h_min-midpoint rows at s knots), in
-                [1e-8, 0.1]; errors relative to max(value, floor * value at u = 0).
-            loading: a prebuilt ``NormalLaw.elasto_plastic`` of the same surface/material
-                (its build time is then not counted); None builds one at rtol.
-            n_quad, n_t: quadrature of the direct sums (shape rule / height nodes per panel).
-            n_rows, n_s: initial numbers of h_min and s intervals.
-            floor: relative floor of the error measure (pressures below floor * p(h_min)
-                are controlled in absolute terms only).
-            strict: False returns the table of the last round when rtol or the budget is not
-                met (info["worst_checkpoint_error"] says what was reached).
-        Raises:
-            ValueError: bad arguments; RuntimeError: rtol not reached within max_rounds or
-                max_seconds (message: reached accuracy and where).
-        """
-        from .interface.normal import NormalLaw
-        t0 = time.perf_counter()
-        rtol = check_scalar("rtol", rtol, lo=1e-8, hi=0.1, lo_open=False, hi_open=False)
-        floor = check_scalar("floor", floor, lo=0.0, hi=1e-2)
-        mat = material.resolve(surface)
-        if loading is None:
-            loading = NormalLaw.elasto_plastic(surface, mat, rtol)
-        t_load = time.perf_counter() - t0
-        t1 = time.perf_counter()
-        hL, hE = loading.h_min, loading.h_table_end
-        cache = {}
-        n_eval = [0]
-
-        def rows(hms, s):
-            """model rho, d rho/ds, ln a - ln a0 at rows hms and s values (cached)."""
-            out = np.empty((3, len(hms), len(s)))
-            for i, hm in enumerate(hms):
-                key = float(hm)
-                have = cache.setdefault(key, {})
-                need = [x for x in s if float(x) not in have]
-                if need:
-                    L = hE - hm
-                    ss = np.array(need)
-                    allu = np.concatenate([[0.0], ss * L])
-                    p, k, a = _row_sums(surface, mat, hm, allu, n_quad, n_t)
-                    n_eval[0] += allu.size
-                    p0, a0 = p[0], a[0]
-                    pc = np.maximum(p[1:], 1e-300)
-                    for x, pv, kv, av in zip(need, pc, k[1:], np.maximum(a[1:], 1e-300)):
-                        have[float(x)] = (math.log(pv / p0), -kv / pv * L,
-                                          math.log(av / a0), pv / p0, kv * L / p0, av / a0)
-                for j, x in enumerate(s):
-                    out[:, i, j] = have[float(x)][:3]
-            return out
-
-        def errors(hms, s_chk, rho_i, drho_i, la_i):
-            """relative errors of p, k, a at check points against the model."""
-            m = rows(hms, s_chk)
-            P, Pi = np.exp(m[0]), np.exp(rho_i)
-            K, Ki = -m[1] * P, -drho_i * Pi
-            A, Ai = np.exp(m[2]), np.exp(la_i)
-            e = [np.abs(Pi - P) / np.maximum(P, floor), np.abs(Ki - K) / np.maximum(K, floor * K.max()),
-                 np.abs(Ai - A) / np.maximum(A, floor)]
-            return np.maximum.reduce(e)
-
-        hm = np.linspace(hL, hE, n_rows + 1)[:-1]       # the row at h_end itself is empty
-        s = np.linspace(0.0, 1.0, n_s + 1)
-        worst = np.inf
-        for rnd in range(max_rounds):
-            if time.perf_counter() - t1 > max_seconds:
-                if not strict:
-                    break
-                raise RuntimeError(f"HistoryNormalLaw: max_seconds = {max_seconds} s exceeded "
-                                   f"at rtol = {rtol}; reached {worst:.2g}")
-            R, RA = cls._surface(rows(hm, s), hm, s)
-            # (i) s-midpoints on the knot rows
-            sm = 0.5 * (s[:-1] + s[1:])
-            rho_i, drho_i, la_i = cls._patch(R, RA, hm, s, np.repeat(hm[:, None], sm.size, 1),
-                                             np.broadcast_to(sm, (hm.size, sm.size)))
-            e_s = errors(hm, sm, rho_i, drho_i, la_i)          # (n_m, n_s-1)
-            # (ii) h_min-midpoint rows at s knots (and s midpoints)
-            hmid = 0.5 * (hm[:-1] + hm[1:])
-            sc = np.sort(np.concatenate([s, sm]))
-            rho_i, drho_i, la_i = cls._patch(R, RA, hm, s, np.repeat(hmid[:, None], sc.size, 1),
-                                             np.broadcast_to(sc, (hmid.size, sc.size)))
-            e_m = errors(hmid, sc, rho_i, drho_i, la_i)
-            worst = max(e_s.max(), e_m.max())
-            bad_s = (e_s > 0.5 * rtol).any(axis=0)
-            bad_m = (e_m > 0.5 * rtol).any()
-            if not bad_s.any() and not bad_m:
-                break
-            if bad_s.any():
-                s = np.sort(np.concatenate([s, sm[bad_s]]))
-            if bad_m:
-                hm = np.sort(np.concatenate([hm, hmid]))
-        else:
-            if strict:
-                raise RuntimeError(f"HistoryNormalLaw: rtol = {rtol} not reached in {max_rounds} "
-                                   f"rounds (reached {worst:.2g}); loosen rtol or raise max_rounds")
-        R, RA = cls._surface(rows(hm, s), hm, s)
-        info = {"build_seconds": time.perf_counter() - t0, "loading_seconds": t_load,
-                "history_seconds": time.perf_counter() - t1, "rows": hm.size, "s_knots": s.size,
-                "model_points": n_eval[0], "worst_checkpoint_error": float(worst),
-                "n_quad": n_quad, "n_t": n_t, "floor": floor, "reversible": False}
-        return cls(loading=loading, rtol=rtol, _hm=hm, _s=s, _R=R, _RA=RA, info=info)
-
-    @staticmethod
-    def _surface(m, hm, s):
-        """Bicubic Hermite data from model rows m = (rho, d rho/ds, ln a - ln a0)."""
-        from .interface.normal import _limited_slopes
-        rho, rs = m[0], m[1]
-        dm = hm[1] - hm[0] if hm.size > 1 else 1.0
-        la = m[2]
-        las = np.stack([_limited_slopes(s, row) for row in la])
-        R = (rho, rs, _fd_rows(rho, dm), _fd_rows(rs, dm))
-        RA = (la, las, _fd_rows(la, dm), _fd_rows(las, dm))
-        return R, RA
-
-    @staticmethod
-    def _patch(R, RA, hm, s, H, S):
-        """Evaluate (rho, d rho/ds, ln a - ln a0) at rows H (clipped to the grid) and s = S."""
-        n_m = hm.size
-        dm = hm[1] - hm[0] if n_m > 1 else 1.0
-        x = np.clip((H - hm[0]) / dm, 0.0, n_m - 1)
-        i = np.minimum(x.astype(np.intp), max(n_m - 2, 0))
-        tm = x - i
-        j = np.clip(np.searchsorted(s, S, side="right") - 1, 0, s.size - 2)
-        ds = s[j + 1] - s[j]
-        ts = (S - s[j]) / ds
-        Hm, _ = _h_basis(tm)
-        Hs, dHs = _h_basis(ts)
-        i1 = np.minimum(i + 1, n_m - 1)
-        res = []
-        for (v, vs, vm, vms), deriv in ((R, True), (RA, False)):
-            acc = 0.0
-            dacc = 0.0
-            for ia, wa, wad in ((i, Hm[0], Hm[2]), (i1, Hm[1], Hm[3])):
-                for jb, wb, wbd, dwb, dwbd in ((j, Hs[0], Hs[2], dHs[0], dHs[2]),
-                                                (j + 1, Hs[1], Hs[3], dHs[1], dHs[3])):
-                    f = v[ia, jb] * wa + dm * vm[ia, jb] * wad
-                    fs = vs[ia, jb] * wa + dm * vms[ia, jb] * wad
-                    acc = acc + f * wb + ds * fs * wbd
-                    if deriv:
-                        dacc = dacc + (f * dwb + ds * fs * dwbd) / ds
-            res.append(acc)
-            if deriv:
-                res.append(dacc)
-        return res[0], res[1], res[2]
-
-    # ------------------------------------------------------------ evaluation
-    def evaluate(self, h, h_min):
-        """(p [MPa], k = -dp/dh at fixed h_min [MPa/mm], A/A0 [-]) at separations h, history h_min.
-
-        Args:
-            h: separations [mm] (finite or +inf); h_min: smallest separation reached so far [mm]
-                (broadcast with h). Where h <= h_min the point is loading (h_min := h, the
-                caller commits min(h_min, h)) and the loading ``NormalLaw`` is returned.
-        """
-        h = np.asarray(h, dtype=float)
-        hmn = np.asarray(h_min, dtype=float)
-        if np.isnan(h).any() or np.isnan(hmn).any():
-            raise ValueError("h or h_min contains NaN: valid range (-inf, inf] mm")
-        h, hmn = np.broadcast_arrays(h, hmn)
-        shape = h.shape
-        h, hmn = h.ravel(), hmn.ravel()
-        p, k, a = (v.ravel().copy() for v in self.loading.evaluate(np.minimum(h, hmn)
-                                                                   if self._R is None else h))
-        if self._R is None:                     # reversible (elastic)
-            return p.reshape(shape), k.reshape(shape), a.reshape(shape)
-        hL, hE = self.loading.h_min, self.loading.h_table_end
-        un = np.flatnonzero((h > hmn) & (hmn < hE))
-        if un.size:
-            hu, hmu = h[un], hmn[un]
-            p0, _, a0 = self.loading.evaluate(hmu)
-            L = hE - np.maximum(hmu, hL)
-            S = (hu - hmu) / L
-            Sc = np.minimum(S, 1.0)
-            rho, drho, la = self._patch(self._R, self._RA, self._hm, self._s,
-                                        np.maximum(hmu, hL), Sc)
-            pu = p0 * np.exp(rho)
-            ku = -pu * drho / L
-            au = a0 * np.exp(la)
-            tp = S > 1.0
-            if tp.any():                        # cubic taper (as NormalLaw) beyond s = 1
-                Lt = 3.0 * pu[tp] / np.maximum(ku[tp], 1e-300)
-                t = np.clip((hu[tp] - (hmu[tp] + L[tp])) / Lt, 0.0, 1.0)
-                kk = 3.0 * pu[tp] / Lt * (1 - t) ** 2
-                pu[tp] = pu[tp] * (1 - t) ** 3
-                au[tp] = au[tp] * (1 - t) ** 3
-                ku[tp] = kk
-            p[un], k[un], a[un] = pu, ku, au
-        return p.reshape(shape), k.reshape(shape), a.reshape(shape)
