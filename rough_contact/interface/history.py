@@ -302,7 +302,8 @@ class HistoryNormalLaw:
         use = rr > math.log(tail)
         if not use.any():
             return 0.0
-        ek = np.abs(np.exp(r - rr) * (dr / dx) / drr - 1.0)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ek = np.where(drr < 0, np.abs(np.exp(r - rr) * (dr / dx) / drr - 1.0), np.inf)
         e = np.maximum.reduce([np.abs(np.expm1(r - rr)), ek, np.abs(np.expm1(la - lar))])
         return float(e[use].max())
 

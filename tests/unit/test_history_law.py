@@ -179,3 +179,50 @@ def test_elastic_history_law_is_exactly_reversible():
                                                    InterfaceState.zeros(h.size))
     np.testing.assert_array_equal(r1.traction, r0.traction)
     np.testing.assert_array_equal(r1.normal_dissipation, 0.0)
+
+
+def _coarse_table():
+    """A deliberately coarse elasto-plastic history table (a few hundred direct-sum points,
+    strict=False): its mechanics do not depend on its accuracy."""
+    from rough_contact.micro.asperity import AsperityMaterial
+    mat = AsperityMaterial(E_star=1.14e5, psi=1.0).resolve(S1)
+    loading = NormalLaw.elasto_plastic(S1, mat, rtol=1e-2)
+    return HistoryNormalLaw.elasto_plastic(S1, mat, 1e-3, loading=loading, n_quad=8, n_t=16,
+                                           n_rows=2, n_x=4, max_points=40, strict=False)
+
+
+@pytest.mark.slow    # ~10-25 s: a loading NormalLaw and a few dozen direct population sums
+def test_table_mechanics_continuity_tangent_energy():
+    """The tabulated law: p and A/A0 continuous at the reversal (the branch starts at the
+    loading law's value exactly), k the exact derivative of p on the unloading branch (FD),
+    unloading stiffer than loading at h_min, and D(h_min) = work of loading minus the energy
+    recoverable on the branch, the latter integrated here by a trapezoid rule over
+    evaluate_history (not the table's own Gauss sums)."""
+    law = _coarse_table()
+    assert not law.reversible and law.info["model_points"] > 0
+    sig = S1.rq
+    hms = np.array([-0.3, 0.5, 2.0, 4.0]) * sig
+    p0, k0, a0 = law.loading.evaluate(hms)
+    p, k, a = law.evaluate_history(hms, hms)
+    np.testing.assert_array_equal(p, p0)          # h == h_min is the loading branch
+    eps = 1e-9 * sig
+    pu, ku, au = law.evaluate_history(hms + eps, hms)
+    np.testing.assert_allclose(pu, p0, rtol=1e-6)
+    np.testing.assert_allclose(au, a0, rtol=1e-6)
+    assert np.all(ku > k0)
+    # FD tangent on the branch
+    h = hms[:, None] + np.array([0.05, 0.5, 1.5, 3.0]) * sig
+    H = np.broadcast_to(hms[:, None], h.shape)
+    _, k, _ = law.evaluate_history(h, H)
+    d = 1e-6 * sig
+    fd = (law.evaluate_history(h - d, H)[0] - law.evaluate_history(h + d, H)[0]) / (2 * d)
+    np.testing.assert_allclose(k, fd, rtol=1e-5)
+    # dissipation at the table's rows (where D is computed; between rows it is interpolated):
+    # D = W_load - E_rec, each integrated independently here
+    for hm in law._hm0 + law._dm * np.arange(2):
+        hh = np.linspace(hm, law.h_max + 2 * sig, 200001)
+        W = np.trapz(law.loading.evaluate(hh)[0], hh)
+        E = np.trapz(law.evaluate_history(hh, np.full_like(hh, hm))[0], hh)
+        assert float(law.normal_dissipation(np.array([hm]))[0]) == pytest.approx(W - E, rel=1e-3)
+    D = law.normal_dissipation(np.linspace(-0.4, 7.0, 300) * sig)
+    assert np.all(D >= 0) and np.all(np.diff(D) <= 1e-15 * D.max())
