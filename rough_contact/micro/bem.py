@@ -1005,10 +1005,13 @@ def law_from_curves(curves: BEMCurves) -> BEMLaw:
         ps, ks, as_ = vals.std(axis=0, ddof=1)
         a_pix = np.mean([_hermite_eval(*t, h)[2] for t in pix], axis=0)
         ratio = np.full((h.size, 2), np.nan)
-        if np.isfinite(curves.tangential_stiffness).all():
-            # the ratio kT/kN varies slowly: average each realisation's ratio at equal h
+        with_kt = [r for r in range(nr) if np.isfinite(curves.tangential_stiffness[r]).all()]
+        if with_kt:
+            # the ratio kT/kN varies slowly (and little between realisations): average the
+            # ratio of each realisation that has it, at equal h
             rr = []
-            for r, t in enumerate(tabs):
+            for r in with_kt:
+                t = tabs[r]
                 o = np.argsort(curves.separation[r])
                 kt = curves.tangential_stiffness[r][o] / t[2][:, None]
                 rr.append([np.interp(h, t[0], kt[:, j]) for j in range(2)])
@@ -1120,6 +1123,8 @@ def bem_law_from_moments(moments: SpectralMoments, *, E_star: float, nu: float =
                          hardness: Optional[float] = None, backend: Optional[str] = None,
                          tol: Optional[float] = None, tangential: bool = True,
                          rtol: Optional[float] = None, area_extrapolation: Optional[bool] = None,
+                         amplitudes: str = "random",
+                         tangential_realisations: Optional[int] = None, workers: int = 1,
                          cache: bool = True,
                          cache_dir: Optional[os.PathLike] = None) -> BEMLaw:
     """The BEM law of a surface known only by its spectral moments, with realisation scatter.
@@ -1145,13 +1150,21 @@ def bem_law_from_moments(moments: SpectralMoments, *, E_star: float, nu: float =
         pixels_per_wavelength=pixels_per_wavelength, periods=periods, seed=seed,
         pressures=pressures, area_range=area_range, n_pressures=n_pressures, hardness=hardness,
         backend=backend, tol=tol, tangential=tangential, rtol=rtol,
-        area_extrapolation=area_extrapolation, cache=cache, cache_dir=cache_dir,
-        rms_slope=math.sqrt(moments.m20 + moments.m02))
+        area_extrapolation=area_extrapolation, amplitudes=amplitudes,
+        tangential_realisations=tangential_realisations, workers=workers, cache=cache,
+        cache_dir=cache_dir, rms_slope=math.sqrt(moments.m20 + moments.m02))
     out.info["spectrum"] = {"C_mm4": spec.C, "q_l": spec.q_l, "q_r": spec.q_r,
                             "q_s": spec.q_s, "hurst": spec.hurst, "gx": spec.gx,
                             "gy": spec.gy}
     out.normal.info.update(out.info)
     return out
+
+
+def _bem_curves_job(kw: dict) -> BEMCurves:
+    """One realisation's :func:`bem_curves` (a picklable job for a process pool)."""
+    kw = dict(kw)
+    z, dx, dy = kw.pop("z"), kw.pop("dx"), kw.pop("dy")
+    return bem_curves(z, dx, dy, **kw)
 
 
 def bem_law_from_spectrum(spectrum, *, E_star: float, nu: float = 0.3,
@@ -1161,7 +1174,10 @@ def bem_law_from_spectrum(spectrum, *, E_star: float, nu: float = 0.3,
                           hardness: Optional[float] = None, backend: Optional[str] = None,
                           tol: Optional[float] = None, tangential: bool = True,
                           rtol: Optional[float] = None,
-                          area_extrapolation: Optional[bool] = None, cache: bool = True,
+                          area_extrapolation: Optional[bool] = None,
+                          amplitudes: str = "random",
+                          tangential_realisations: Optional[int] = None,
+                          workers: int = 1, cache: bool = True,
                           cache_dir: Optional[os.PathLike] = None,
                           rms_slope: Optional[float] = None) -> BEMLaw:
     """The BEM law of a surface given by its spectrum: Gaussian realisations, averaged.
@@ -1183,6 +1199,14 @@ def bem_law_from_spectrum(spectrum, *, E_star: float, nu: float = 0.3,
             tabulate it; None (default): when pixels_per_wavelength >= 6 (the half-resolution
             grid then still has >= 3 pixels per shortest wavelength: same surface, asymptotic
             range of the pixel-count error).
+        amplitudes: "random" (Gaussian random fields: independent samples of the surface) or
+            "fixed" (random phases, every mode at its expected modulus: the realisations share
+            the spectrum's discrete moments exactly, which removes most of the scatter of p at
+            equal separation between realisations; docs/bem.md, "Realisation scatter").
+        tangential_realisations: with ``tangential``, compute the stick stiffness for the first
+            this many realisations only (None: all); the ratio kT/kN scatters little between
+            realisations (docs/bem.md), and it is the costliest part of a solve.
+        workers: realisations solved in parallel processes (>= 1; each is single-threaded).
         rms_slope: rms slope of the surface (default: from the spectrum's moments), for the
             default pressures.
 
@@ -1199,18 +1223,29 @@ def bem_law_from_spectrum(spectrum, *, E_star: float, nu: float = 0.3,
             m = spectrum.moments()
             rms_slope = math.sqrt(m.m20 + m.m02)
         pressures = default_pressures(E_star, rms_slope, hardness, area_range, n_pressures)
-    curves = []
-    for r in range(nr):
-        zr = spectrum.realisation((nx, ny), (Lx, Ly), seed + r)
-        curves.append(bem_curves(zr, Lx / nx, Ly / ny, E_star=E_star, nu=nu,
-                                 pressures=pressures, hardness=hardness, backend=backend,
-                                 tol=tol, tangential=tangential,
-                                 rtol=rtol if r == 0 else None,
-                                 area_extrapolation=area_extrapolation, cache=cache,
-                                 cache_dir=cache_dir))
-        pressures = curves[0].pressure
+    workers = int(check_scalar("workers", workers, lo=1.0, lo_open=False, hi=256))
+    n_kt = nr if tangential_realisations is None else int(tangential_realisations)
+
+    def job(r, pr, refine):
+        return dict(z=spectrum.realisation((nx, ny), (Lx, Ly), seed + r, amplitudes),
+                    dx=Lx / nx, dy=Ly / ny, E_star=E_star, nu=nu, pressures=pr,
+                    hardness=hardness, backend=backend, tol=tol,
+                    tangential=tangential and r < n_kt, rtol=rtol if refine else None,
+                    area_extrapolation=area_extrapolation, cache=cache, cache_dir=cache_dir)
+
+    # the first realisation fixes the pressures (with rtol it refines them)
+    curves = [_bem_curves_job(job(0, pressures, True))]
+    pressures = curves[0].pressure
+    rest = [job(r, pressures, False) for r in range(1, nr)]
+    if workers > 1 and rest:
+        from concurrent.futures import ProcessPoolExecutor
+
+        with ProcessPoolExecutor(max_workers=workers) as ex:
+            curves += list(ex.map(_bem_curves_job, rest))
+    else:
+        curves += [_bem_curves_job(j) for j in rest]
     out = law_from_curves(BEMCurves.stack(curves))
-    out.info.update({"spectrum_type": type(spectrum).__name__,
+    out.info.update({"spectrum_type": type(spectrum).__name__, "amplitudes": amplitudes,
                      "pixels_per_wavelength": float(pixels_per_wavelength),
                      "periods": int(periods), "seeds": [seed + r for r in range(nr)]})
     out.normal.info.update(out.info)

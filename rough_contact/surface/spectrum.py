@@ -50,7 +50,7 @@ from ..validation import check_scalar
 
 __all__ = ["SpectrumShape", "StretchedSpectrum", "fit_spectrum", "example_surfaces",
            "SurfaceSpectrum", "TabulatedPSD", "PSDSurface", "gaussian_realisation",
-           "expected_discrete_moments"]
+           "expected_discrete_moments", "AMPLITUDES"]
 
 # relative mismatch of m04/m40 against (m02/m20)^2 above which fit_spectrum warns
 _MOMENT_MISMATCH_WARN = 0.05
@@ -170,22 +170,24 @@ class StretchedSpectrum:
         return (n, n), (L / self.gx, L / self.gy)
 
     def realisation(self, shape: Tuple[int, int], size: Tuple[float, float],
-                    seed: int) -> np.ndarray:
+                    seed: int, amplitudes: str = "random") -> np.ndarray:
         """A periodic Gaussian random field with this spectrum (filtered white noise).
 
-        Private generator of this module (the topography module has the public one): the mode
-        amplitudes are complex Gaussian with variance Phi(q) dqx dqy, so the heights are
-        Gaussian and the expected discrete moments are the sums of Phi over the grid's modes.
+        The mode amplitudes are complex Gaussian with variance Phi(q) dqx dqy (or, with
+        ``amplitudes="fixed"``, of exactly that modulus with random phases), so the heights are
+        Gaussian and the expected discrete moments are the sums of Phi over the grid's modes
+        (:func:`gaussian_realisation`).
 
         Args:
             shape: (nx, ny) pixels, each >= 4.
             size: (Lx, Ly) periods [mm].
             seed: seed of numpy's default generator.
+            amplitudes: "random" or "fixed".
 
         Returns:
             heights (nx, ny) [mm], zero mean, C-contiguous; axis 0 is x.
         """
-        return gaussian_realisation(self.psd, shape, size, seed)
+        return gaussian_realisation(self.psd, shape, size, seed, amplitudes)
 
     def discrete_moments(self, shape: Tuple[int, int], size: Tuple[float, float]) -> dict:
         """Expected moments of :meth:`realisation` on this grid (sums over its modes), mm units.
@@ -195,23 +197,33 @@ class StretchedSpectrum:
         return expected_discrete_moments(self.psd, shape, size)
 
 
+AMPLITUDES = ("random", "fixed")
+
+
 def gaussian_realisation(psd, shape: Tuple[int, int], size: Tuple[float, float],
-                         seed: int) -> np.ndarray:
+                         seed: int, amplitudes: str = "random") -> np.ndarray:
     """A periodic Gaussian random field with the spectrum ``psd`` (filtered white noise).
 
-    The mode amplitudes are complex Gaussian with variance Phi(q) dqx dqy, so the heights are
-    Gaussian and the expected discrete moments are the sums of Phi over the grid's modes
-    (:func:`expected_discrete_moments`). Phi is symmetrised, (Phi(q) + Phi(-q))/2.
+    ``amplitudes="random"``: the mode amplitudes are complex Gaussian with variance
+    Phi(q) dqx dqy, so the heights are Gaussian and the expected discrete moments are the sums of
+    Phi over the grid's modes (:func:`expected_discrete_moments`). ``"fixed"``: every mode has
+    exactly that modulus and a random phase (the random-phase surface of Appendix A): the
+    moments of every realisation *equal* those sums (no scatter of m00 ... m04 between
+    realisations, a variance reduction for averages over realisations; heights Gaussian by the
+    central limit theorem over the many modes). Phi is symmetrised, (Phi(q) + Phi(-q))/2.
 
     Args:
         psd: Phi(qx, qy) [mm^4] at angular wavenumbers [rad/mm] (broadcast).
         shape: (nx, ny) pixels, each >= 4; axis 0 is x.
         size: (Lx, Ly) periods [mm].
         seed: seed of numpy's default generator.
+        amplitudes: "random" (Gaussian random field) or "fixed" (random phases only).
 
     Returns:
         heights (nx, ny) [mm], zero mean, C-contiguous.
     """
+    if amplitudes not in AMPLITUDES:
+        raise ValueError(f"amplitudes = {amplitudes!r} is invalid; valid: {AMPLITUDES}")
     nx, ny = (int(v) for v in shape)
     if min(nx, ny) < 4:
         raise ValueError(f"shape = {shape!r} is invalid: at least 4 x 4 pixels are needed")
@@ -228,6 +240,12 @@ def gaussian_realisation(psd, shape: Tuple[int, int], size: Tuple[float, float],
     rng = np.random.default_rng(seed)
     # rfft2 of real white noise has E|W|^2 = nx ny, Hermitian symmetry is kept by irfft2
     W = np.fft.rfft2(rng.standard_normal((nx, ny)))
+    if amplitudes == "fixed":
+        # unit modulus times sqrt(nx ny), the rms modulus of W: |Z| = sqrt(Phi dq nx ny) exactly.
+        # The self-conjugate modes (q = 0, Nyquist) of the half spectrum are real: their sign
+        # is kept (a phase of 0 or pi), the rest is Hermitian by construction of irfft2
+        mag = np.abs(W)
+        W = np.divide(W, mag, out=np.ones_like(W), where=mag > 0) * math.sqrt(nx * ny)
     z = np.fft.irfft2(W * amp, s=(nx, ny))
     return np.ascontiguousarray(z - z.mean())
 
@@ -362,7 +380,7 @@ class SurfaceSpectrum(Protocol):
              periods: int = 1) -> Tuple[Tuple[int, int], Tuple[float, float]]: ...
 
     def realisation(self, shape: Tuple[int, int], size: Tuple[float, float],
-                    seed: int) -> np.ndarray: ...
+                    seed: int, amplitudes: str = "random") -> np.ndarray: ...
 
 
 @dataclass(frozen=True, eq=False)
@@ -560,10 +578,10 @@ class PSDSurface:
         return (out_n[0], out_n[1]), (out_L[0], out_L[1])
 
     def realisation(self, shape: Tuple[int, int], size: Tuple[float, float],
-                    seed: int) -> np.ndarray:
+                    seed: int, amplitudes: str = "random") -> np.ndarray:
         """A periodic Gaussian random field with this PSD: heights (nx, ny) [mm], axis 0 = x
-        (:func:`gaussian_realisation`)."""
-        return gaussian_realisation(self.psd_mm, shape, size, seed)
+        (:func:`gaussian_realisation`; ``amplitudes`` "random" or "fixed")."""
+        return gaussian_realisation(self.psd_mm, shape, size, seed, amplitudes)
 
     def discrete_moments(self, shape: Tuple[int, int], size: Tuple[float, float]) -> dict:
         """Expected moments of :meth:`realisation` on this grid (mm;

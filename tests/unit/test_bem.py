@@ -656,3 +656,37 @@ def test_bem_law_from_a_user_psd(tmp_path):
     assert law.curves.grid == s.grid(3.0)[0]
     assert law.info["area_source"] == "pixel count"          # ppw < 6: no extrapolation
     assert 0.005 < law.area_fraction.min() < law.area_fraction.max() < 0.5
+
+
+def test_fixed_amplitude_realisations_carry_the_spectrum_moments_exactly():
+    """amplitudes="fixed": every realisation's FFT moments equal the sums of Phi over the grid's
+    modes (no scatter), the heights stay Gaussian (kurtosis 3 within sampling error)."""
+    spec = fit_spectrum(iso_moments())
+    shape, size = spec.grid(4.0, periods=2)
+    dx, dy = size[0] / shape[0], size[1] / shape[1]
+    exp = spec.discrete_moments(shape, size)
+    for seed in range(3):
+        z = spec.realisation(shape, size, seed, amplitudes="fixed")
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", UserWarning)
+            got = moments_from_height_map(z, dx, dy, unit="mm")
+        for name in ("m00", "m20", "m02", "m40", "m04"):
+            assert getattr(got, name) == pytest.approx(exp[name], rel=0.02), name
+        kurt = np.mean(z ** 4) / np.mean(z ** 2) ** 2
+        assert abs(kurt - 3) < 0.3
+    with pytest.raises(ValueError, match="amplitudes"):
+        spec.realisation(shape, size, 0, amplitudes="unit")
+
+
+@pytest.mark.filterwarnings("ignore::rough_contact.micro.bem.HeightMapWarning")
+def test_parallel_realisations_and_partial_tangential(tmp_path):
+    kw = dict(E_star=E_STAR, nu=NU, n_realisations=3, pixels_per_wavelength=3.0,
+              n_pressures=4, area_range=(0.02, 0.2), backend="numpy", cache=False,
+              tangential=True, tangential_realisations=1)
+    one = bem.bem_law_from_moments(iso_moments(), **kw)
+    two = bem.bem_law_from_moments(iso_moments(), workers=2, **kw)
+    np.testing.assert_array_equal(one.pressure, two.pressure)
+    np.testing.assert_array_equal(one.area_fraction, two.area_fraction)
+    kt = one.curves.tangential_stiffness
+    assert np.isfinite(kt[0]).all() and np.isnan(kt[1:]).all()
+    assert np.isfinite(one.tangential_ratio).all()
