@@ -11,8 +11,9 @@ where the mean law has A/A0 = 1, 3, 10, 30 %:
 * the standard error of the mean of ``n`` realisations, std / sqrt(n), for the ``n`` that
   compare_laws.py would use (``--use``), the uncertainty of the BEM reference.
 
-    bash run.sh python benchmarks/bench_bem_scatter.py                    # ~5 min, cached after
-    bash run.sh python benchmarks/bench_bem_scatter.py --periods 1 2 4 --realisations 16
+    bash run.sh python benchmarks/bench_bem_scatter.py --periods 1 --realisations 8
+    bash run.sh python benchmarks/bench_bem_scatter.py --periods 1 --realisations 48 \
+        --amplitudes fixed --use 48           # the compare_laws.py default (~10 min, 2 cores)
 
 Units: mm, MPa. Results are cached (rough_contact.micro.bem.default_cache_dir()).
 """
@@ -70,6 +71,7 @@ def main(argv=None):
     ap.add_argument("--amplitudes", default="random", choices=["random", "fixed"],
                     help="Gaussian random fields, or random phases at fixed moduli")
     ap.add_argument("--backend", default="numpy", choices=["tamaas", "numpy"])
+    ap.add_argument("--workers", type=int, default=2, help="realisations in parallel")
     ap.add_argument("--csv", default="docs/bem_scatter.csv")
     args = ap.parse_args(argv)
     m, shape = example_surfaces()[args.surface]
@@ -83,7 +85,7 @@ def main(argv=None):
                 m, shape=shape, E_star=E_STAR, nu=NU, n_realisations=args.realisations,
                 pixels_per_wavelength=args.ppw, periods=P, n_pressures=args.pressures,
                 area_range=(0.003, 0.3), backend=args.backend, tangential=False,
-                area_extrapolation=True, amplitudes=args.amplitudes)
+                area_extrapolation=True, amplitudes=args.amplitudes, workers=args.workers)
         dt = time.perf_counter() - t0
         grid = law.info["grid"]
         for r in scatter(law):
