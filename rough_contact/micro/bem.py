@@ -1238,9 +1238,13 @@ def bem_law_from_spectrum(spectrum, *, E_star: float, nu: float = 0.3,
     pressures = curves[0].pressure
     rest = [job(r, pressures, False) for r in range(1, nr)]
     if workers > 1 and rest:
+        import multiprocessing
         from concurrent.futures import ProcessPoolExecutor
 
-        with ProcessPoolExecutor(max_workers=workers) as ex:
+        # spawn, not fork: the caller may hold threads (FFT, BLAS, MPI) that fork would copy
+        # in an undefined state
+        ctx = multiprocessing.get_context("spawn")
+        with ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as ex:
             curves += list(ex.map(_bem_curves_job, rest))
     else:
         curves += [_bem_curves_job(j) for j in rest]
