@@ -105,7 +105,8 @@ def build_laws(comm, surface, realisations, ppw, small, backend=None, tangential
             b = bem.bem_law_from_moments(
                 m, E_star=E_star, nu=punch.NU, n_realisations=2 if small else realisations,
                 pixels_per_wavelength=3.0 if small else ppw, n_pressures=6 if small else 14,
-                area_range=(0.002, 0.45), tangential=tangential, backend=backend)
+                area_range=(0.002, 0.45), tangential=tangential, backend=backend,
+                tangential_realisations=4)
         laws = {"statistical": stat, "BEM": b.normal}
         info = dict(b.info)
         if tangential:
