@@ -16,7 +16,9 @@ Quantities (all per unit nominal area; internal units mm, N, MPa):
   gap between the flat and the deformed surface. With the gap g(x) = d + u(x) - z(x),
   d = mean over the elastic contact points of z - u.
 * pressure ``p`` [MPa]: mean contact pressure (the load per nominal area).
-* area fraction ``a = A/A0`` [-]: fraction of pixels carrying pressure (pixel counting).
+* area fraction ``a = A/A0`` [-]: fraction of pixels carrying pressure (pixel counting, biased
+  high at first order in the pixel size); with ``area_extrapolation`` also the Richardson
+  estimate 2 A(grid) - A(grid/2) from the map sub-sampled by 2, which the table then uses.
 * normal stiffness ``k = -dp/dh`` [MPa/mm]: computed from each solution by Barber's relation:
   with the contact set C (elastic contact points) frozen, an approach dh moves every point of C
   by dh, so k = mean(dp) where dp, supported on C, solves (K dp)|_C = 1 (K the half-space

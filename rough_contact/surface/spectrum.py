@@ -24,6 +24,10 @@ Assumed spectrum (a *stretched isotropic self-affine spectrum with roll-off*):
   6561 = 81^2); for other moments the best compromise m4 = sqrt(m40 m04) is used and a
   ``UserWarning`` names the moments actually realised.
 
+A surface whose spectrum is *known* (a callable Phi or a table, e.g. a Gaussian
+autocorrelation) needs no assumed shape: :class:`PSDSurface` integrates its moments and
+synthesises its realisations (:class:`TabulatedPSD` for tables).
+
 Moment convention as in :mod:`rough_contact.surface`: PSD over angular wavenumbers normalised so
 that m00 = <z^2> = integral Phi dqx dqy, m_pq = integral Phi qx^p qy^q dqx dqy. For the
 isotropic base: m00 = 2 pi I1, m2 = pi I3, m4 = (3 pi / 4) I5 with I_n = integral Phi q^n dq.
