@@ -16,7 +16,9 @@ Quantities (all per unit nominal area; internal units mm, N, MPa):
   gap between the flat and the deformed surface. With the gap g(x) = d + u(x) - z(x),
   d = mean over the elastic contact points of z - u.
 * pressure ``p`` [MPa]: mean contact pressure (the load per nominal area).
-* area fraction ``a = A/A0`` [-]: fraction of pixels carrying pressure (pixel counting).
+* area fraction ``a = A/A0`` [-]: fraction of pixels carrying pressure (pixel counting, biased
+  high at first order in the pixel size); with ``area_extrapolation`` also the Richardson
+  estimate 2 A(grid) - A(grid/2) from the map sub-sampled by 2, which the table then uses.
 * normal stiffness ``k = -dp/dh`` [MPa/mm]: computed from each solution by Barber's relation:
   with the contact set C (elastic contact points) frozen, an approach dh moves every point of C
   by dh, so k = mean(dp) where dp, supported on C, solves (K dp)|_C = 1 (K the half-space
@@ -76,6 +78,7 @@ if TYPE_CHECKING:          # annotations only: the law class lives in the layer 
 __all__ = [
     "BEMCurves", "BEMLaw", "BackendUnavailableError", "HeightMapWarning",
     "available_backends", "bem_curves", "bem_normal_law", "bem_law_from_moments",
+    "bem_law_from_spectrum",
     "check_height_map", "spacing_from_coordinates", "mindlin_ratio", "law_ratios",
     "agreement_range", "default_cache_dir", "default_pressures", "law_from_curves",
     "HalfSpace", "NumpySolver", "TamaasSolver", "MapDiagnostics", "resolution_check",
@@ -573,6 +576,9 @@ class BEMCurves:
         cached: (n_r,) True where the result came from the disk cache.
         refinement_error: with ``rtol``, the largest midpoint error of the last refinement
             round (p, and k for elastic contact); None without refinement.
+        area_fraction_extrapolated: (n_r, n_p) Richardson estimate of A/A0,
+            2 A(grid) - A(grid/2), at the same pressures (``area_extrapolation=True``), or None.
+            ``area_fraction`` stays the raw pixel count.
     """
 
     pressure: np.ndarray
@@ -590,6 +596,7 @@ class BEMCurves:
     build_time: np.ndarray
     cached: np.ndarray
     refinement_error: Optional[float] = None
+    area_fraction_extrapolated: Optional[np.ndarray] = None
 
     @property
     def n_realisations(self) -> int:
@@ -603,7 +610,12 @@ class BEMCurves:
             if not np.array_equal(c.pressure, c0.pressure):
                 raise ValueError("curves were computed at different pressures")
         cat = lambda name: np.concatenate([getattr(c, name) for c in curves])  # noqa: E731
+        ext = [c.area_fraction_extrapolated is not None for c in curves]
+        if any(ext) and not all(ext):
+            raise ValueError("some curves have an extrapolated area and some have not")
         return replace(c0, separation=cat("separation"), area_fraction=cat("area_fraction"),
+                       area_fraction_extrapolated=cat("area_fraction_extrapolated")
+                       if all(ext) else None,
                        stiffness=cat("stiffness"),
                        tangential_stiffness=cat("tangential_stiffness"),
                        rms_height=cat("rms_height"), build_time=cat("build_time"),
@@ -617,7 +629,7 @@ def default_cache_dir() -> Path:
 
 
 def _cache_key(z: np.ndarray, size, E_star, nu, hardness, pressures, backend, tol,
-               tangential, rtol=None) -> str:
+               tangential, rtol=None, area_extrapolation=False) -> str:
     h = hashlib.sha256()
     h.update(np.ascontiguousarray(z, dtype=np.float64).tobytes())
     meta = dict(v=_CACHE_VERSION, shape=list(z.shape), size=[float(s) for s in size],
@@ -627,6 +639,8 @@ def _cache_key(z: np.ndarray, size, E_star, nu, hardness, pressures, backend, to
                 tangential=bool(tangential))
     if rtol is not None:            # (absent key: results cached before refinement existed)
         meta["rtol"] = float(rtol)
+    if area_extrapolation:          # likewise
+        meta["area_extrapolation"] = True
     h.update(json.dumps(meta, sort_keys=True).encode())
     return h.hexdigest()[:32]
 
@@ -657,7 +671,8 @@ def bem_curves(z, dx: float, dy: Optional[float] = None, *, E_star: float, nu: f
                pressures, hardness: Optional[float] = None, backend: Optional[str] = None,
                boundary: str = "periodic", tol: Optional[float] = None,
                tangential: bool = True, rtol: Optional[float] = None, max_pressures: int = 64,
-               cache: bool = True, cache_dir: Optional[os.PathLike] = None) -> BEMCurves:
+               area_extrapolation: bool = False, cache: bool = True,
+               cache_dir: Optional[os.PathLike] = None) -> BEMCurves:
     """Solve the rough contact of one height map at the given mean pressures.
 
     Args:
@@ -679,6 +694,15 @@ def bem_curves(z, dx: float, dy: Optional[float] = None, *, E_star: float, nu: f
             until all pass or ``max_pressures`` is reached (the worst remaining error is then in
             ``BEMCurves.refinement_error``).
         max_pressures: limit of the refinement.
+        area_extrapolation: also solve the map sub-sampled by 2 (every other pixel, a quarter
+            of the pixels) at the same pressures and report the Richardson estimate
+            2 A(grid) - A(grid/2) of the real-area fraction beside the raw pixel count
+            (``BEMCurves.area_fraction_extrapolated``): pixel counting overestimates A/A0 at
+            first order in the pixel size (docs/bem.md, "Real area"). Exact sub-sampling of
+            the same surface needs a map without content at wavelengths below 4 pixels
+            (synthetic realisations at >= 4 pixels per shortest wavelength); otherwise a
+            HeightMapWarning says how much slope variance the coarse grid loses. Needs an even
+            number of pixels per side (after mirroring).
         cache: read/write the result in the disk cache (keyed by the prepared heights, the grid,
             E*, nu, H, the pressures, the backend, tol, rtol and the code version).
         cache_dir: cache directory (default :func:`default_cache_dir`).
@@ -705,8 +729,11 @@ def bem_curves(z, dx: float, dy: Optional[float] = None, *, E_star: float, nu: f
     size = (zp.shape[0] * dx, zp.shape[1] * dy)
     if rtol is not None:
         rtol = check_scalar("rtol", rtol, lo=1e-6, lo_open=False, hi=0.1)
+    area_extrapolation = bool(area_extrapolation)
+    if area_extrapolation:
+        _check_subsampling(zp, dx, dy)
     key = _cache_key(zp, size, E_star, nu, hardness, pressures, backend, tol, tangential,
-                     rtol)
+                     rtol, area_extrapolation)
     path = Path(cache_dir or default_cache_dir()) / f"bem_{key}.npz"
     if cache and path.exists():
         with np.load(path, allow_pickle=False) as f:
@@ -721,7 +748,9 @@ def bem_curves(z, dx: float, dy: Optional[float] = None, *, E_star: float, nu: f
                              rms_height=np.array([diag.rms_height]),
                              build_time=np.array([meta["build_time"]]),
                              cached=np.array([True]),
-                             refinement_error=meta.get("refinement_error"))
+                             refinement_error=meta.get("refinement_error"),
+                             area_fraction_extrapolated=f["area_fraction_extrapolated"][None]
+                             if "area_fraction_extrapolated" in f else None)
     t0 = time.perf_counter()
     solver = _solver(backend, zp, size, E_star, nu, hardness, tol)
     K = HalfSpace(zp.shape, size, E_star, nu)
@@ -742,8 +771,12 @@ def bem_curves(z, dx: float, dy: Optional[float] = None, *, E_star: float, nu: f
     if rtol is not None:
         pressures, d, a, k, kt, worst = _refine(solve_all, pressures, d, a, k, kt, rtol,
                                                 hardness is None, int(max_pressures))
+    a_ext = None
+    if area_extrapolation:
+        a_ext = 2.0 * a - _coarse_areas(zp, size, E_star, nu, hardness, backend, tol, pressures)
     elapsed = time.perf_counter() - t0
     out = BEMCurves(pressure=pressures, separation=d[None], area_fraction=a[None],
+                    area_fraction_extrapolated=None if a_ext is None else a_ext[None],
                     stiffness=k[None], tangential_stiffness=kt[None], backend=solver.name,
                     grid=tuple(zp.shape), size=size, E_star=E_star, nu=nu, hardness=hardness,
                     rms_height=np.array([diag.rms_height]), build_time=np.array([elapsed]),
@@ -751,11 +784,45 @@ def bem_curves(z, dx: float, dy: Optional[float] = None, *, E_star: float, nu: f
     if cache:
         path.parent.mkdir(parents=True, exist_ok=True)
         tmp = path.with_name(path.name + f".{os.getpid()}.tmp.npz")
+        extra = {} if a_ext is None else {"area_fraction_extrapolated": a_ext}
         np.savez(tmp, pressure=pressures, separation=d, area_fraction=a, stiffness=k,
-                 tangential_stiffness=kt,
+                 tangential_stiffness=kt, **extra,
                  meta=json.dumps({"backend": solver.name, "build_time": elapsed,
                                   "refinement_error": worst}))
         os.replace(tmp, path)   # atomic: a concurrent reader never sees half a file
+    return out
+
+
+def _check_subsampling(zp: np.ndarray, dx: float, dy: float) -> float:
+    """Fraction of the slope variance of zp at wavelengths below 4 pixels (lost by the grid/2
+    of the area extrapolation); ValueError for an odd side, HeightMapWarning above 1 %."""
+    if zp.shape[0] % 2 or zp.shape[1] % 2:
+        raise ValueError(f"area_extrapolation needs an even number of pixels per side, got "
+                         f"{zp.shape} (crop one row/column, or use boundary='mirror')")
+    P = np.abs(_rfft2(zp)) ** 2
+    kx = np.abs(np.fft.fftfreq(zp.shape[0]))[:, None]        # cycles per pixel
+    ky = np.abs(np.fft.rfftfreq(zp.shape[1]))[None, :]
+    w = P * ((kx / dx) ** 2 + (ky / dy) ** 2)
+    lost = float(w[(kx > 0.25) | (ky > 0.25)].sum() / w.sum())
+    if lost > 0.01:
+        warnings.warn(
+            f"{lost:.1%} of the map's slope variance lies at wavelengths below 4 pixels, which "
+            "the half-resolution grid of the area extrapolation does not carry: the "
+            "extrapolated A/A0 mixes that loss of roughness into the discretisation error",
+            HeightMapWarning, stacklevel=3)
+    return lost
+
+
+def _coarse_areas(zp, size, E_star, nu, hardness, backend, tol, pressures) -> np.ndarray:
+    """Pixel-counted A/A0 of the map sub-sampled by 2 at the given pressures."""
+    zc = np.ascontiguousarray(zp[::2, ::2])
+    zc = zc - zc.mean()
+    solver = _solver(backend, zc, size, E_star, nu, hardness, tol)
+    out = np.empty(pressures.size)
+    p = None
+    for j, pm in enumerate(pressures):
+        p = solver.solve(pm, p)
+        out[j] = float((p > 0).mean())
     return out
 
 
@@ -813,7 +880,9 @@ class BEMLaw:
             equal separation (zeros for one map): the error band of a single realisation; the
             mean's standard error is std / sqrt(n_realisations).
         tangential_ratio: (n, 2) kT_x/kN, kT_y/kN in full stick (NaN if not computed) [-].
-        info: backend, grid, timings, interpolation-error estimates, k source, ...
+        info: backend, grid, timings, interpolation-error estimates, k source, area source...
+        area_fraction_pixel: (n,) the raw pixel-counted A/A0 at the same separations (equal to
+            ``area_fraction`` unless that is the Richardson estimate, ``info["area_source"]``).
     """
 
     normal: NormalLaw
@@ -827,6 +896,7 @@ class BEMLaw:
     area_std: np.ndarray
     tangential_ratio: np.ndarray
     info: dict = field(default_factory=dict)
+    area_fraction_pixel: Optional[np.ndarray] = None
 
     def tangential(self):
         """:class:`TangentialStiffness` with the BEM ratios kT/kN averaged over the table.
@@ -842,10 +912,12 @@ class BEMLaw:
         return TangentialStiffness((float(r[0]), float(r[1])))
 
 
-def _realisation_table(c: BEMCurves, r: int):
-    """(h, p, k, a) of realisation r, ordered by increasing h."""
+def _realisation_table(c: BEMCurves, r: int, area: Optional[np.ndarray] = None):
+    """(h, p, k, a) of realisation r, ordered by increasing h; a from ``area`` (n_r, n_p) if
+    given, else the pixel count."""
     o = np.argsort(c.separation[r])
-    return c.separation[r][o], c.pressure[o], c.stiffness[r][o], c.area_fraction[r][o]
+    a = c.area_fraction if area is None else area
+    return c.separation[r][o], c.pressure[o], c.stiffness[r][o], a[r][o]
 
 
 def _hermite_eval(h, p, k, a, x):
@@ -898,12 +970,28 @@ def law_from_curves(curves: BEMCurves) -> BEMLaw:
     The table uses the BEM stiffness as Hermite slope data when the elastic law is tabulated
     and the data are consistent (monotone), else the PCHIP derivative (always for a hardness:
     there the frozen-set stiffness misses the first-order growth of the saturated set).
+
+    A/A0: the Richardson estimate when the curves carry one (``area_extrapolation=True``) and
+    it is positive everywhere, else the pixel count; the pixel count at the table's
+    separations is kept beside it (``BEMLaw.area_fraction_pixel``, ``info["area_source"]``).
     """
     nr = curves.n_realisations
     use_k = curves.hardness is None
-    tabs = [_realisation_table(curves, r) for r in range(nr)]
+    ext = curves.area_fraction_extrapolated
+    area_source = "pixel count"
+    if ext is not None:
+        if np.all(ext > 0) and np.all(ext <= curves.area_fraction):
+            area_source = "Richardson 2 A(grid) - A(grid/2)"
+        else:
+            warnings.warn("the Richardson estimate of A/A0 is outside (0, pixel count] at some "
+                          "pressure (coarse grid outside its asymptotic range): the table keeps "
+                          "the pixel count", HeightMapWarning, stacklevel=2)
+            ext = None
+    tabs = [_realisation_table(curves, r, ext) for r in range(nr)]
+    pix = [_realisation_table(curves, r) for r in range(nr)]
     if nr == 1:
         h, p, k, a = tabs[0]
+        a_pix = pix[0][3]
         ps = ks = as_ = np.zeros_like(h)
         kt = curves.tangential_stiffness[0][np.argsort(curves.separation[0])]
         ratio = kt / k[:, None]
@@ -917,11 +1005,15 @@ def law_from_curves(curves: BEMCurves) -> BEMLaw:
         vals = np.array([_hermite_eval(*t, h) for t in tabs])        # (nr, 3, n)
         p, k, a = vals.mean(axis=0)
         ps, ks, as_ = vals.std(axis=0, ddof=1)
+        a_pix = np.mean([_hermite_eval(*t, h)[2] for t in pix], axis=0)
         ratio = np.full((h.size, 2), np.nan)
-        if np.isfinite(curves.tangential_stiffness).all():
-            # the ratio kT/kN varies slowly: average each realisation's ratio at equal h
+        with_kt = [r for r in range(nr) if np.isfinite(curves.tangential_stiffness[r]).all()]
+        if with_kt:
+            # the ratio kT/kN varies slowly (and little between realisations): average the
+            # ratio of each realisation that has it, at equal h
             rr = []
-            for r, t in enumerate(tabs):
+            for r in with_kt:
+                t = tabs[r]
                 o = np.argsort(curves.separation[r])
                 kt = curves.tangential_stiffness[r][o] / t[2][:, None]
                 rr.append([np.interp(h, t[0], kt[:, j]) for j in range(2)])
@@ -931,6 +1023,8 @@ def law_from_curves(curves: BEMCurves) -> BEMLaw:
         "source": "bem", "backend": curves.backend, "grid": list(curves.grid),
         "size_mm": list(curves.size), "realisations": nr, "hardness": curves.hardness,
         "E_star": curves.E_star, "nu": curves.nu, "k_source": source,
+        "area_source": area_source,
+        "area_pixel_range": [float(a_pix.min()), float(a_pix.max())],
         "build_time_s": float(np.sum(curves.build_time)),
         "cached": int(np.count_nonzero(curves.cached)),
         "pressure_range": [float(p.min()), float(p.max())],
@@ -946,7 +1040,7 @@ def law_from_curves(curves: BEMCurves) -> BEMLaw:
     law.info.update(info)
     return BEMLaw(normal=law, curves=curves, separation=h, pressure=p, stiffness=k,
                   area_fraction=a, pressure_std=ps, stiffness_std=ks, area_std=as_,
-                  tangential_ratio=ratio, info=info)
+                  tangential_ratio=ratio, info=info, area_fraction_pixel=a_pix)
 
 
 def default_pressures(E_star: float, rms_slope: float, hardness: Optional[float] = None,
@@ -989,7 +1083,8 @@ def bem_normal_law(z, dx: float, dy: Optional[float] = None, *, E_star: float, n
                    n_pressures: int = 16, hardness: Optional[float] = None,
                    backend: Optional[str] = None, boundary: str = "periodic",
                    tol: Optional[float] = None, tangential: bool = True,
-                   rtol: Optional[float] = None, cache: bool = True,
+                   rtol: Optional[float] = None, area_extrapolation: bool = False,
+                   cache: bool = True,
                    cache_dir: Optional[os.PathLike] = None) -> BEMLaw:
     """The BEM normal law of one height map (measured or synthetic).
 
@@ -1001,7 +1096,8 @@ def bem_normal_law(z, dx: float, dy: Optional[float] = None, *, E_star: float, n
             :func:`default_pressures` over ``area_range`` with ``n_pressures`` values.
         hardness: None (elastic) or the pressure cap H [MPa] (saturated, elasto-plastic).
         backend: None (default: "tamaas" for elastic, "numpy" for saturated), "tamaas", "numpy".
-        boundary, tol, tangential, cache, cache_dir: see :func:`bem_curves`.
+        boundary, tol, tangential, area_extrapolation, cache, cache_dir: see
+            :func:`bem_curves`.
         rtol: None, or refine the pressures until the table meets rtol at the interval
             midpoints (:func:`bem_curves`; k carries pixel-level noise of about 0.5-1 % at
             8 pixels per shortest wavelength, so rtol below that is not reachable).
@@ -1017,7 +1113,8 @@ def bem_normal_law(z, dx: float, dy: Optional[float] = None, *, E_star: float, n
         pressures = default_pressures(E_star, diag.rms_slope, hardness, area_range, n_pressures)
     c = bem_curves(z, dx, dy, E_star=E_star, nu=nu, pressures=pressures, hardness=hardness,
                    backend=backend, boundary=boundary, tol=tol, tangential=tangential,
-                   rtol=rtol, cache=cache, cache_dir=cache_dir)
+                   rtol=rtol, area_extrapolation=area_extrapolation, cache=cache,
+                   cache_dir=cache_dir)
     return law_from_curves(c)
 
 
@@ -1027,16 +1124,71 @@ def bem_law_from_moments(moments: SpectralMoments, *, E_star: float, nu: float =
                          area_range: Tuple[float, float] = (0.005, 0.3), n_pressures: int = 16,
                          hardness: Optional[float] = None, backend: Optional[str] = None,
                          tol: Optional[float] = None, tangential: bool = True,
-                         rtol: Optional[float] = None, cache: bool = True,
+                         rtol: Optional[float] = None, area_extrapolation: Optional[bool] = None,
+                         amplitudes: str = "random",
+                         tangential_realisations: Optional[int] = None, workers: int = 1,
+                         cache: bool = True,
                          cache_dir: Optional[os.PathLike] = None) -> BEMLaw:
     """The BEM law of a surface known only by its spectral moments, with realisation scatter.
 
     Gaussian realisations of the spectrum fitted by :func:`rough_contact.surface.spectrum.fit_spectrum`
     (the assumed shape is documented there: stretched isotropic self-affine with roll-off) are
-    solved at the same pressures and averaged at equal separation (:func:`law_from_curves`).
+    solved at the same pressures and averaged at equal separation (:func:`law_from_curves`);
+    :func:`bem_law_from_spectrum` does the work.
 
     Args:
         moments: :class:`SpectralMoments` (x = grain direction).
+        shape: :class:`rough_contact.surface.spectrum.SpectrumShape` (default H = 0.8, plateau 2).
+        the others: as in :func:`bem_law_from_spectrum`.
+
+    Returns:
+        :class:`BEMLaw` whose ``*_std`` give the scatter between realisations.
+    """
+    from rough_contact.surface.spectrum import SpectrumShape, fit_spectrum
+
+    spec = fit_spectrum(moments, SpectrumShape() if shape is None else shape)
+    out = bem_law_from_spectrum(
+        spec, E_star=E_star, nu=nu, n_realisations=n_realisations,
+        pixels_per_wavelength=pixels_per_wavelength, periods=periods, seed=seed,
+        pressures=pressures, area_range=area_range, n_pressures=n_pressures, hardness=hardness,
+        backend=backend, tol=tol, tangential=tangential, rtol=rtol,
+        area_extrapolation=area_extrapolation, amplitudes=amplitudes,
+        tangential_realisations=tangential_realisations, workers=workers, cache=cache,
+        cache_dir=cache_dir, rms_slope=math.sqrt(moments.m20 + moments.m02))
+    out.info["spectrum"] = {"C_mm4": spec.C, "q_l": spec.q_l, "q_r": spec.q_r,
+                            "q_s": spec.q_s, "hurst": spec.hurst, "gx": spec.gx,
+                            "gy": spec.gy}
+    out.normal.info.update(out.info)
+    return out
+
+
+def _bem_curves_job(kw: dict) -> BEMCurves:
+    """One realisation's :func:`bem_curves` (a picklable job for a process pool)."""
+    kw = dict(kw)
+    z, dx, dy = kw.pop("z"), kw.pop("dx"), kw.pop("dy")
+    return bem_curves(z, dx, dy, **kw)
+
+
+def bem_law_from_spectrum(spectrum, *, E_star: float, nu: float = 0.3,
+                          n_realisations: int = 4, pixels_per_wavelength: float = 4.0,
+                          periods: int = 1, seed: int = 0, pressures=None,
+                          area_range: Tuple[float, float] = (0.005, 0.3), n_pressures: int = 16,
+                          hardness: Optional[float] = None, backend: Optional[str] = None,
+                          tol: Optional[float] = None, tangential: bool = True,
+                          rtol: Optional[float] = None,
+                          area_extrapolation: Optional[bool] = None,
+                          amplitudes: str = "random",
+                          tangential_realisations: Optional[int] = None,
+                          workers: int = 1, cache: bool = True,
+                          cache_dir: Optional[os.PathLike] = None,
+                          rms_slope: Optional[float] = None) -> BEMLaw:
+    """The BEM law of a surface given by its spectrum: Gaussian realisations, averaged.
+
+    Args:
+        spectrum: a :class:`rough_contact.surface.spectrum.SurfaceSpectrum` - a
+            :class:`~rough_contact.surface.spectrum.PSDSurface` (the user's own PSD, a callable
+            or a :class:`~rough_contact.surface.spectrum.TabulatedPSD`) or a
+            :class:`~rough_contact.surface.spectrum.StretchedSpectrum`.
         E_star, nu, hardness, backend, tol, tangential, rtol, cache, cache_dir: as in
             :func:`bem_normal_law` (with rtol the first realisation chooses the pressures, the
             others are solved at the same ones).
@@ -1044,34 +1196,62 @@ def bem_law_from_moments(moments: SpectralMoments, *, E_star: float, nu: float =
         pixels_per_wavelength: pixels per shortest wavelength of the spectrum (grid study in
             docs/bem.md).
         periods: longest wavelengths per side of every realisation.
-        shape: :class:`rough_contact.surface.spectrum.SpectrumShape` (default H = 0.8, plateau 2).
-        pressures: mean pressures [MPa]; default from the moments' rms slope over area_range.
+        pressures: mean pressures [MPa]; default from the rms slope over area_range.
+        area_extrapolation: report the Richardson estimate of A/A0 (:func:`bem_curves`) and
+            tabulate it; None (default): when pixels_per_wavelength >= 6 (the half-resolution
+            grid then still has >= 3 pixels per shortest wavelength: same surface, asymptotic
+            range of the pixel-count error).
+        amplitudes: "random" (Gaussian random fields: independent samples of the surface) or
+            "fixed" (random phases, every mode at its expected modulus: the realisations share
+            the spectrum's discrete moments exactly, which removes most of the scatter of p at
+            equal separation between realisations; docs/bem.md, "Realisation scatter").
+        tangential_realisations: with ``tangential``, compute the stick stiffness for the first
+            this many realisations only (None: all); the ratio kT/kN scatters little between
+            realisations (docs/bem.md), and it is the costliest part of a solve.
+        workers: realisations solved in parallel processes (>= 1; each is single-threaded).
+        rms_slope: rms slope of the surface (default: from the spectrum's moments), for the
+            default pressures.
 
     Returns:
         :class:`BEMLaw` whose ``*_std`` give the scatter between realisations.
     """
-    from rough_contact.surface.spectrum import SpectrumShape, fit_spectrum
-
     nr = int(check_scalar("n_realisations", n_realisations, lo=1.0, lo_open=False, hi=1e4))
     backend = _default_backend(backend, hardness)
-    spec = fit_spectrum(moments, SpectrumShape() if shape is None else shape)
-    (nx, ny), (Lx, Ly) = spec.grid(pixels_per_wavelength, periods)
+    (nx, ny), (Lx, Ly) = spectrum.grid(pixels_per_wavelength, periods)
+    if area_extrapolation is None:
+        area_extrapolation = pixels_per_wavelength >= 6.0
     if pressures is None:
-        pressures = default_pressures(E_star, math.sqrt(moments.m20 + moments.m02), hardness,
-                                      area_range, n_pressures)
-    curves = []
-    for r in range(nr):
-        zr = spec.realisation((nx, ny), (Lx, Ly), seed + r)
-        curves.append(bem_curves(zr, Lx / nx, Ly / ny, E_star=E_star, nu=nu,
-                                 pressures=pressures, hardness=hardness, backend=backend,
-                                 tol=tol, tangential=tangential,
-                                 rtol=rtol if r == 0 else None, cache=cache,
-                                 cache_dir=cache_dir))
-        pressures = curves[0].pressure
+        if rms_slope is None:
+            m = spectrum.moments()
+            rms_slope = math.sqrt(m.m20 + m.m02)
+        pressures = default_pressures(E_star, rms_slope, hardness, area_range, n_pressures)
+    workers = int(check_scalar("workers", workers, lo=1.0, lo_open=False, hi=256))
+    n_kt = nr if tangential_realisations is None else int(tangential_realisations)
+
+    def job(r, pr, refine):
+        return dict(z=spectrum.realisation((nx, ny), (Lx, Ly), seed + r, amplitudes),
+                    dx=Lx / nx, dy=Ly / ny, E_star=E_star, nu=nu, pressures=pr,
+                    hardness=hardness, backend=backend, tol=tol,
+                    tangential=tangential and r < n_kt, rtol=rtol if refine else None,
+                    area_extrapolation=area_extrapolation, cache=cache, cache_dir=cache_dir)
+
+    # the first realisation fixes the pressures (with rtol it refines them)
+    curves = [_bem_curves_job(job(0, pressures, True))]
+    pressures = curves[0].pressure
+    rest = [job(r, pressures, False) for r in range(1, nr)]
+    if workers > 1 and rest:
+        import multiprocessing
+        from concurrent.futures import ProcessPoolExecutor
+
+        # spawn, not fork: the caller may hold threads (FFT, BLAS, MPI) that fork would copy
+        # in an undefined state
+        ctx = multiprocessing.get_context("spawn")
+        with ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as ex:
+            curves += list(ex.map(_bem_curves_job, rest))
+    else:
+        curves += [_bem_curves_job(j) for j in rest]
     out = law_from_curves(BEMCurves.stack(curves))
-    out.info.update({"spectrum": {"C_mm4": spec.C, "q_l": spec.q_l, "q_r": spec.q_r,
-                                  "q_s": spec.q_s, "hurst": spec.hurst, "gx": spec.gx,
-                                  "gy": spec.gy},
+    out.info.update({"spectrum_type": type(spectrum).__name__, "amplitudes": amplitudes,
                      "pixels_per_wavelength": float(pixels_per_wavelength),
                      "periods": int(periods), "seeds": [seed + r for r in range(nr)]})
     out.normal.info.update(out.info)

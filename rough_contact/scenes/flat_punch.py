@@ -75,8 +75,10 @@ PLASTIC = dict(Y=2070.0, K_Y=1.62, psi=0.35, ch=0.967, omega_p_ratio=45.0)
 # stiffness kT = c kN.  ``law="penalty"`` gives a smooth unilateral penalty with Coulomb friction
 # instead (a stand-in for debugging the FE layer).
 def make_law(comm, law="rough", case="b", normal_law="elastic", seating_pressure=None,
-             normal=None):
-    """Interface law and its normal law; ``normal`` (a prebuilt NormalLaw) skips the build."""
+             normal=None, kt_over_kn=None):
+    """Interface law and its normal law; ``normal`` (a prebuilt NormalLaw) skips the build;
+    ``kt_over_kn`` (kTx/kN, kTy/kN) replaces the friction case's tangential ratios (e.g. the
+    BEM's, ``rough_contact.micro.bem.BEMLaw.tangential``)."""
     from rough_contact.interface.friction import OrthotropicSlipHardening
     from rough_contact.interface.law import InterfaceLaw
     from rough_contact.interface.penalty import SoftplusPenalty
@@ -112,7 +114,8 @@ def make_law(comm, law="rough", case="b", normal_law="elastic", seating_pressure
         friction = OrthotropicSlipHardening(mu_macro=c["mu_macro"],
                                             mu_initial_ratio=c["mu_initial_ratio"],
                                             hardening=HARDENING, potential_axes=c["nu"])
-        rough = InterfaceLaw(normal=normal, tangential=TangentialStiffness(c["kt"]),
+        kt = c["kt"] if kt_over_kn is None else tuple(kt_over_kn)
+        rough = InterfaceLaw(normal=normal, tangential=TangentialStiffness(kt),
                              friction=friction)
     return rough.with_seating(seating_pressure), normal
 
@@ -176,7 +179,8 @@ def build(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2, load_h
           law="rough", case="b", normal_law="elasto-plastic", steps=16, prefix="rc_",
           dof_threshold=None, quadrature_degree=None, normal=None, seating_steps=None,
           cell_type="tetrahedron", *, punch_scene=None, total_force=TOTAL_FORCE,
-          solver_defaults=None, quadrature="gauss", solver_options=None, enforcement=None):
+          solver_defaults=None, quadrature="gauss", solver_options=None, enforcement=None,
+          kt_over_kn=None):
     """Mesh, law, interface, problem and solver of the quarter punch. Collective.
 
     ``quadrature`` is the interface rule (``"gauss"`` of ``quadrature_degree``, default 2 x
@@ -188,6 +192,8 @@ def build(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2, load_h
     defaults (without prefix) that the command line can override; ``solver_options`` are
     extra keyword arguments of :class:`~rough_contact.solver.snes.SNESSolver` (e.g.
     ``linear_solver="hypre"``); ``dof_threshold=None`` is the solver's measured default.
+
+    ``kt_over_kn`` (kTx/kN, kTy/kN) replaces the friction case's tangential stiffness ratios.
 
     ``normal`` passes a prebuilt NormalLaw (same on every rank); ``seating_steps`` (default
     ``steps``) sets the seating pressure to the nominal pressure of 1/seating_steps of the load.
@@ -217,7 +223,7 @@ def build(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2, load_h
     p_seat = quarter_force / (seating_steps or steps) / contact_area
     if isinstance(law, str):
         interface_law, normal = make_law(comm, law, case, normal_law, seating_pressure=p_seat,
-                                         normal=normal)
+                                         normal=normal, kt_over_kn=kt_over_kn)
     else:
         interface_law = law
 

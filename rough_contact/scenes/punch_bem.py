@@ -5,7 +5,11 @@ case (b)) is loaded twice on the same rough surface, once with the statistical e
 (asperity sums) and once with the BEM law of that surface (:mod:`rough_contact.micro.bem`: exact
 elastic contact of Gaussian realisations of the surface's spectrum). Everything else is
 identical, so the differences are the effect of the normal law: approach of the loaded patch,
-interface closure, int k dA, real contact area, dissipation. The default load is a bolted-joint
+interface closure, int k dA, real contact area, dissipation. The tangential stiffness is the
+friction case's kT = c kN (the paper's c = 0.7) unless ``kt="bem"``: then both runs take the
+ratios kT/kN the BEM computes for the surface in full stick (``BEMLaw.tangential``; Mindlin's
+2(1 - nu)/(2 - nu) for an isotropic surface, different along and across the grain of an
+anisotropic one), so the comparison still isolates the normal law. The default load is a bolted-joint
 level 50 kN (nominal 125 MPa), where the contact pressures lie inside the BEM table
 (``docs/bem.md``). Library code (no petsc4py.init, no sys.argv). Units: mm, N, MPa.
 """
@@ -66,11 +70,15 @@ class LawComparison:
         statistical: increments with the statistical elastic law (:class:`LawIncrement`).
         bem: increments with the BEM law.
         num_dofs: global number of DOFs (same mesh for both).
+        kt_over_kn: (kTx/kN, kTy/kN) used by both runs [-].
+        kt_source: "case (c)" for the friction case's ratios, "bem" for the BEM's.
     """
 
     statistical: list
     bem: list
     num_dofs: int
+    kt_over_kn: tuple = (0.7, 0.7)
+    kt_source: str = "case"
 
     def items(self):
         """(law name, increments) pairs: ("statistical", ...), ("BEM", ...)."""
@@ -78,8 +86,9 @@ class LawComparison:
 
 
 # ## The two normal laws (built on rank 0, copied to the others)
-def build_laws(comm, surface, realisations, ppw, small, backend=None):
-    """{"statistical": NormalLaw, "BEM": NormalLaw} and the BEMLaw info. Collective."""
+def build_laws(comm, surface, realisations, ppw, small, backend=None, tangential=False):
+    """{"statistical": NormalLaw, "BEM": NormalLaw} and the BEMLaw info (with
+    ``info["kt_over_kn"]``, the BEM's stick ratios, when ``tangential``). Collective."""
     laws = info = None
     if comm.rank == 0:
         import warnings
@@ -96,18 +105,23 @@ def build_laws(comm, surface, realisations, ppw, small, backend=None):
             b = bem.bem_law_from_moments(
                 m, E_star=E_star, nu=punch.NU, n_realisations=2 if small else realisations,
                 pixels_per_wavelength=3.0 if small else ppw, n_pressures=6 if small else 14,
-                area_range=(0.002, 0.45), tangential=False, backend=backend)
+                area_range=(0.002, 0.45), tangential=tangential, backend=backend,
+                tangential_realisations=4)
         laws = {"statistical": stat, "BEM": b.normal}
         info = dict(b.info)
+        if tangential:
+            info["kt_over_kn"] = b.tangential().kt_over_kn
     return comm.bcast(laws, root=0), comm.bcast(info, root=0)
 
 
 # ## One run of the punch with a given normal law
-def run_with_law(comm, normal, force, steps, case, mesh_size, contact_size, order, verbose):
+def run_with_law(comm, normal, force, steps, case, mesh_size, contact_size, order, verbose,
+                 kt_over_kn=None):
     """Load to ``force`` in ``steps`` increments; returns (list of :class:`LawIncrement`,
-    number of DOFs), identical on every rank. Collective."""
+    number of DOFs), identical on every rank. Collective. ``kt_over_kn`` replaces the friction
+    case's tangential ratios."""
     m = punch.build(comm, mesh_size, contact_size, order, case=case, normal_law="elastic",
-                    steps=steps, normal=normal, total_force=float(force))
+                    steps=steps, normal=normal, total_force=float(force), kt_over_kn=kt_over_kn)
     scene, problem, solver, interface, law = m.scene, m.problem, m.solver, m.interface, m.law
     uz_load = SurfaceMean(problem.u, scene.facet_tags, scene.tag("load"), 2)
     rows = []
@@ -138,22 +152,36 @@ def run_with_law(comm, normal, force, steps, case, mesh_size, contact_size, orde
 
 def run(surface="anisotropic", force=50e3, steps=8, case="b", mesh_size=20.0, contact_size=2.0,
          order=2, realisations=8, ppw=8.0, small=False, backend=None, outdir=None,
-         comm=MPI.COMM_WORLD, verbose=True):
-    """Run both laws; print the comparison; return a :class:`LawComparison`. Collective."""
+         comm=MPI.COMM_WORLD, verbose=True, kt="case"):
+    """Run both laws; print the comparison; return a :class:`LawComparison`. Collective.
+
+    ``kt``: "case" (the friction case's kT/kN, the paper's 0.7) or "bem" (the BEM's stick
+    ratios of this surface, in both runs; computing them about doubles the BEM build)."""
+    if kt not in ("case", "bem"):
+        raise ValueError(f"kt = {kt!r} is invalid; valid: 'case' (the friction case's kT/kN) "
+                         "or 'bem' (the BEM's stick ratios)")
     t0 = MPI.Wtime()
     if small:
         mesh_size, contact_size, order, steps = 40.0, 5.0, 1, 2
-    laws, info = build_laws(comm, surface, realisations, ppw, small, backend)
+    laws, info = build_laws(comm, surface, realisations, ppw, small, backend,
+                            tangential=(kt == "bem"))
+    kt_ratio = tuple(info["kt_over_kn"]) if kt == "bem" else tuple(punch.FRICTION_CASES[case]["kt"])
     PETSc.Sys.Print(f"Normal laws of the '{surface}' surface: statistical elastic "
                     f"({laws['statistical'].n_intervals} intervals) and BEM ({info['backend']}, "
                     f"{info['realisations']} realisations of {info['grid'][0]}x{info['grid'][1]} "
                     f"px, A/A0 {info['area_range'][0]:.3g}-{info['area_range'][1]:.3g}, "
                     f"p {info['pressure_range'][0]:.3g}-{info['pressure_range'][1]:.3g} MPa); "
                     f"built in {MPI.Wtime() - t0:.1f} s", comm=comm)
+    from rough_contact.micro.bem import mindlin_ratio
+
+    PETSc.Sys.Print(f"tangential stiffness kT/kN = ({kt_ratio[0]:.3f}, {kt_ratio[1]:.3f}) in "
+                    "both runs, " + ("computed by the BEM in full stick" if kt == "bem" else
+                                     f"friction case ({case}); --kt bem takes the BEM's")
+                    + f" (Mindlin's circular contact: {mindlin_ratio(punch.NU):.3f})", comm=comm)
     out = {}
     for name, normal in laws.items():
         rows, ndofs = run_with_law(comm, normal, force, steps, case, mesh_size, contact_size,
-                                   order, verbose=False)
+                                   order, verbose=False, kt_over_kn=kt_ratio)
         out[name] = rows
         PETSc.Sys.Print(f"  {name:12s}: {ndofs} DOFs, {rows[-1].n_points} interface points, "
                         f"{len(rows)} increments, max force error "
@@ -200,6 +228,7 @@ def run(surface="anisotropic", force=50e3, steps=8, case="b", mesh_size=20.0, co
                     w.writerow([name] + list(astuple(r)))
     for rows in out.values():
         assert max(r.force_error for r in rows) < 1e-6, "force balance violated"
-    return LawComparison(statistical=out["statistical"], bem=out["BEM"], num_dofs=ndofs)
+    return LawComparison(statistical=out["statistical"], bem=out["BEM"], num_dofs=ndofs,
+                         kt_over_kn=kt_ratio, kt_source=kt)
 
 

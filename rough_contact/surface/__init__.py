@@ -26,8 +26,10 @@ from .moments import (ANISOTROPY_WARN_RATIO, MOMENT_ORDERS, WINDOWS, MomentTenso
                       SpectralMoments, moment_tensor_from_height_map, moments_from_height_map,
                       plasticity_index, psum)
 from .spectrum import SpectrumShape, StretchedSpectrum, example_surfaces, fit_spectrum
-from .topography import (DETRENDS, LENGTH_UNITS, MIN_PIXELS, AnisotropicGaussianPSD, HeightMap,
-                         ModelAdvice, PowerSpectrum, SurfaceAnalysis, analyze, detrend,
+from .topography import (DETRENDS, LENGTH_UNITS, MAX_PLAUSIBLE_RMS_SLOPE, MIN_PIXELS,
+                         MIN_PLAUSIBLE_CURVATURE_RADIUS, AnisotropicGaussianPSD, HeightMap,
+                         ModelAdvice, PowerSpectrum, SurfaceAnalysis, analyze,
+                         check_units_plausible, detrend,
                          model_advice, read_height_map, read_instrument, read_npy,
                          read_text_grid, read_xyz, synthetic_height_map, write_height_map,
                          write_npy, write_text_grid, write_xyz)
@@ -36,7 +38,9 @@ __all__ = [
     "ANISOTROPY_WARN_RATIO", "MOMENT_ORDERS", "WINDOWS", "MomentTensor", "SpectralMoments",
     "moment_tensor_from_height_map", "moments_from_height_map", "plasticity_index", "psum",
     "SpectrumShape", "StretchedSpectrum", "example_surfaces", "fit_spectrum",
-    "DETRENDS", "LENGTH_UNITS", "MIN_PIXELS", "AnisotropicGaussianPSD", "HeightMap",
+    "DETRENDS", "LENGTH_UNITS", "MIN_PIXELS", "MAX_PLAUSIBLE_RMS_SLOPE",
+    "MIN_PLAUSIBLE_CURVATURE_RADIUS", "check_units_plausible", "AnisotropicGaussianPSD",
+    "HeightMap",
     "ModelAdvice", "PowerSpectrum", "SurfaceAnalysis", "analyze", "detrend", "model_advice",
     "read_height_map", "read_instrument", "read_npy", "read_text_grid", "read_xyz",
     "synthetic_height_map", "write_height_map", "write_npy", "write_text_grid", "write_xyz",

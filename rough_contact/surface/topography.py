@@ -41,6 +41,7 @@ from .moments import (ANISOTROPY_WARN_RATIO, WINDOWS, MomentTensor, SpectralMome
 from ..validation import check_scalar
 
 __all__ = ["HeightMap", "LENGTH_UNITS", "MIN_PIXELS", "DETRENDS", "detrend",
+           "MAX_PLAUSIBLE_RMS_SLOPE", "MIN_PLAUSIBLE_CURVATURE_RADIUS", "check_units_plausible",
            "PowerSpectrum", "AnisotropicGaussianPSD", "synthetic_height_map",
            "ModelAdvice", "SurfaceAnalysis", "analyze", "model_advice",
            "read_height_map", "write_height_map", "read_npy", "write_npy", "read_text_grid",
@@ -56,6 +57,15 @@ DETRENDS = ("none", "mean", "plane", "curvature")
 ORTHOTROPY_WARN_DEG = 5.0
 # coordinates of an xyz file must lie within this fraction of a step of a uniform grid
 XYZ_GRID_TOL = 1e-3
+# Plausibility of the stated units (read_* functions; docs/measured_surfaces.md, "Units").
+# rms slope (per axis, after removing the mean plane) above which a map is refused: measured
+# engineering surfaces have rms slopes of about 0.01-0.3 (ground, turned, milled, blasted) and
+# stylus (60-90 deg cone) and optical instruments (numerical aperture <= 0.95) cannot follow
+# flanks much steeper than 45 deg, i.e. slope 1; larger values almost always mean mixed units.
+MAX_PLAUSIBLE_RMS_SLOPE = 1.0
+# rms curvature radius [mm] below which a map is refused: 1 nm, a few atomic spacings and below
+# the radius of the sharpest probe tips (AFM 2-10 nm, stylus >= 0.1 um)
+MIN_PLAUSIBLE_CURVATURE_RADIUS = 1e-6
 # unit spellings of instrument files (SurfaceTopography) -> (our unit, factor)
 _UNIT_ALIASES = {"nm": ("nm", 1.0), "um": ("um", 1.0), "µm": ("um", 1.0), "μm": ("um", 1.0),
                  "mm": ("mm", 1.0), "m": ("m", 1.0), "Å": ("nm", 0.1), "A": ("nm", 0.1),
@@ -520,15 +530,92 @@ def _spacings(dx, dy, file_dx, file_dy, path):
     return dx, _merge("dy", None if dy is None else float(dy), file_dy, path)
 
 
-def _finish(z, dx, dy, unit, height_unit, path) -> HeightMap:
+def _finish(z, dx, dy, unit, height_unit, path, allow_steep=False) -> HeightMap:
     unit = _check_unit(unit)
     if height_unit is not None:
         z = np.asarray(z, float) * (LENGTH_UNITS[_check_unit(height_unit, "height_unit")]
                                     / LENGTH_UNITS[unit])
     try:
-        return HeightMap(z, float(dx), float(dy), unit)
+        hm = HeightMap(z, float(dx), float(dy), unit)
     except ValueError as e:
         raise ValueError(f"{path}: {e}") from None
+    if not allow_steep:
+        check_units_plausible(hm, height_unit=height_unit, source=path)
+    return hm
+
+
+def _larger_units(unit: str):
+    return [u for u in LENGTH_UNITS if LENGTH_UNITS[u] > LENGTH_UNITS[unit]]
+
+
+def _smaller_units(unit: str):
+    return [u for u in LENGTH_UNITS if LENGTH_UNITS[u] < LENGTH_UNITS[unit]][::-1]
+
+
+def check_units_plausible(hm: HeightMap, height_unit: Optional[str] = None,
+                          source: Optional[PathLike] = None) -> Tuple[float, float, float, float]:
+    """Refuse a map whose slopes or curvatures are implausible for its stated units.
+
+    The mean plane is removed; rms slopes and rms curvatures along x and y are taken by central
+    differences inside the map. A rms slope above ``MAX_PLAUSIBLE_RMS_SLOPE`` (45 deg) almost
+    always means that the lateral unit is larger, or the height unit smaller, than stated
+    (x, y in mm read as um multiplies every slope by 1000); a rms curvature radius below
+    ``MIN_PLAUSIBLE_CURVATURE_RADIUS`` (1 nm) means every length is in a larger unit than
+    stated. A consistent error of all lengths within these bounds cannot be detected. The
+    readers call this unless ``allow_steep=True`` (a genuinely steep surface).
+
+    Args:
+        hm: the map as read.
+        height_unit: the height unit stated to the reader (None: ``hm.unit``), for the message.
+        source: file name for the message.
+    Returns:
+        (rms slope x, rms slope y [-], rms curvature x, rms curvature y [1/unit]).
+    Raises:
+        ValueError: naming the quantity, its value, the plausible range, the likely unit
+            mix-up and the override.
+    """
+    z = detrend(hm, "plane").heights
+    sx = float(np.sqrt(np.mean(((z[1:-1, 2:] - z[1:-1, :-2]) / (2 * hm.dx)) ** 2)))
+    sy = float(np.sqrt(np.mean(((z[2:, 1:-1] - z[:-2, 1:-1]) / (2 * hm.dy)) ** 2)))
+    cx = float(np.sqrt(np.mean(((z[1:-1, 2:] - 2 * z[1:-1, 1:-1] + z[1:-1, :-2]) / hm.dx**2) ** 2)))
+    cy = float(np.sqrt(np.mean(((z[2:, 1:-1] - 2 * z[1:-1, 1:-1] + z[:-2, 1:-1]) / hm.dy**2) ** 2)))
+    hu = hm.unit if height_unit is None else height_unit
+    where = f"{source}: " if source is not None else ""
+    override = ("if the surface really is this steep, pass allow_steep=True to the reader "
+                "(see docs/measured_surfaces.md, 'Units')")
+    slope = max(sx, sy)
+    if slope > MAX_PLAUSIBLE_RMS_SLOPE:
+        axis = "x" if sx >= sy else "y"
+        guesses = []
+        for u in _larger_units(hm.unit):
+            f = LENGTH_UNITS[u] / LENGTH_UNITS[hm.unit]
+            if slope / f <= MAX_PLAUSIBLE_RMS_SLOPE:
+                guesses.append(f"are the lateral units {u} rather than {hm.unit} (slope "
+                               f"{slope / f:.3g})")
+                break
+        for u in _smaller_units(hu):
+            f = LENGTH_UNITS[hu] / LENGTH_UNITS[u]
+            if slope / f <= MAX_PLAUSIBLE_RMS_SLOPE:
+                guesses.append(f"are the heights in {u} rather than {hu} (slope "
+                               f"{slope / f:.3g})")
+                break
+        raise ValueError(
+            f"{where}rms slope {slope:.3g} rad ({axis}; x: {sx:.3g}, y: {sy:.3g}) is implausible "
+            f"for a machined surface (expected < ~{MAX_PLAUSIBLE_RMS_SLOPE:g}, measured "
+            f"engineering surfaces 0.01-0.3): " + ("; or ".join(guesses) + "? "
+                                                   if guesses else "check the units. ")
+            + f"(read with lateral unit {hm.unit!r}, heights in {hu!r}); {override}")
+    curv = max(cx, cy) * 1.0 / LENGTH_UNITS[hm.unit]           # 1/mm
+    if curv * MIN_PLAUSIBLE_CURVATURE_RADIUS > 1.0:
+        axis = "x" if cx >= cy else "y"
+        r_nm = 1e6 / curv
+        raise ValueError(
+            f"{where}rms curvature {max(cx, cy):.3g} 1/{hm.unit} ({axis}), a radius of "
+            f"{r_nm:.3g} nm, is implausible (expected radius > "
+            f"{MIN_PLAUSIBLE_CURVATURE_RADIUS * 1e6:g} nm, a few atomic spacings): are all "
+            f"lengths (lateral unit {hm.unit!r}, heights {hu!r}) in a larger unit than "
+            f"stated? {override}")
+    return sx, sy, cx, cy
 
 
 def _sidecar(path: Path) -> Path:
@@ -545,7 +632,8 @@ def write_npy(hm: HeightMap, path: PathLike) -> Path:
 
 
 def read_npy(path: PathLike, dx: Optional[float] = None, dy: Optional[float] = None,
-             unit: Optional[str] = None, height_unit: Optional[str] = None) -> HeightMap:
+             unit: Optional[str] = None, height_unit: Optional[str] = None,
+             allow_steep: bool = False) -> HeightMap:
     """Read a numpy ``.npy`` array of heights (ny, nx) with the spacing from the caller or from a
     sidecar ``.json`` next to it (keys dx, dy, unit, as :func:`write_npy` writes).
 
@@ -554,6 +642,7 @@ def read_npy(path: PathLike, dx: Optional[float] = None, dy: Optional[float] = N
         dx, dy: spacings [unit] (dy defaults to dx); needed when there is no sidecar.
         unit: length unit of the spacings and of the map.
         height_unit: unit of the stored heights if it differs from ``unit``.
+        allow_steep: skip :func:`check_units_plausible` (a genuinely steep surface).
     """
     path = Path(path)
     meta = {}
@@ -561,7 +650,8 @@ def read_npy(path: PathLike, dx: Optional[float] = None, dy: Optional[float] = N
         meta = json.loads(_sidecar(path).read_text())
     dx, dy = _spacings(dx, dy, meta.get("dx"), meta.get("dy"), path)
     unit = _merge("unit", unit, meta.get("unit"), path)
-    return _finish(np.load(path, allow_pickle=False), dx, dy, unit, height_unit, path)
+    return _finish(np.load(path, allow_pickle=False), dx, dy, unit, height_unit, path,
+                   allow_steep)
 
 
 def _delimiter(line: str) -> Optional[str]:
@@ -614,12 +704,14 @@ def write_text_grid(hm: HeightMap, path: PathLike, delimiter: str = ",") -> Path
 
 def read_text_grid(path: PathLike, dx: Optional[float] = None, dy: Optional[float] = None,
                    unit: Optional[str] = None, height_unit: Optional[str] = None,
-                   delimiter: Optional[str] = None) -> HeightMap:
+                   delimiter: Optional[str] = None, allow_steep: bool = False) -> HeightMap:
     """Read a text/CSV grid of heights: ny rows (y) of nx values (x).
 
     Lines starting with ``#`` are comments; ``# dx = ...``, ``# dy = ...``, ``# unit = ...``
     there give the metadata (as :func:`write_text_grid` writes), else pass them. The delimiter is
-    detected from the first data line (comma, semicolon, tab, else whitespace).
+    detected from the first data line (comma, semicolon, tab, else whitespace). Implausible
+    slopes or curvatures for the stated units raise (:func:`check_units_plausible`) unless
+    ``allow_steep=True``.
     """
     path = Path(path)
     meta, z = _read_table(path, delimiter)
@@ -630,7 +722,7 @@ def read_text_grid(path: PathLike, dx: Optional[float] = None, dy: Optional[floa
                          f"{meta.get('dy')!r} is not a number") from None
     dx, dy = _spacings(dx, dy, mdx, mdy, path)
     unit = _merge("unit", unit, meta.get("unit"), path)
-    return _finish(z, dx, dy, unit, height_unit, path)
+    return _finish(z, dx, dy, unit, height_unit, path, allow_steep)
 
 
 def write_xyz(hm: HeightMap, path: PathLike, delimiter: str = " ") -> Path:
@@ -668,13 +760,15 @@ def _grid_axis(name: str, c: np.ndarray, path: Path) -> Tuple[np.ndarray, int, f
 
 
 def read_xyz(path: PathLike, unit: Optional[str] = None, height_unit: Optional[str] = None,
-             delimiter: Optional[str] = None) -> HeightMap:
+             delimiter: Optional[str] = None, allow_steep: bool = False) -> HeightMap:
     """Read an x y z point list of a map sampled on a uniform grid (any point order).
 
     The points must form a complete uniform grid: distinct x (and y) values equally spaced to
     within ``XYZ_GRID_TOL`` of a step, every grid node present exactly once. ``# unit = ...``
     in a comment line gives the unit (as :func:`write_xyz` writes), else pass ``unit``;
     ``height_unit`` converts a z column in another unit (e.g. x, y in mm and z in um).
+    Implausible slopes or curvatures for the stated units raise
+    (:func:`check_units_plausible`) unless ``allow_steep=True``.
     """
     path = Path(path)
     meta, data = _read_table(path, delimiter)
@@ -693,11 +787,11 @@ def read_xyz(path: PathLike, unit: Optional[str] = None, height_unit: Optional[s
     heights = np.empty((ny, nx))
     heights[iy, ix] = z
     unit = _merge("unit", unit, meta.get("unit"), path)
-    return _finish(heights, dx, dy, unit, height_unit, path)
+    return _finish(heights, dx, dy, unit, height_unit, path, allow_steep)
 
 
 def read_instrument(path: PathLike, unit: Optional[str] = None, channel: Optional[int] = None,
-                    **surface_topography_kwargs) -> HeightMap:
+                    allow_steep: bool = False, **surface_topography_kwargs) -> HeightMap:
     """Read an instrument file through SurfaceTopography (optional extra ``topography``).
 
     About 30 formats (.x3p, .sur, .opd, .opdx, .di, .ibw, .plu, .datx, .nc, ...), detected
@@ -707,6 +801,7 @@ def read_instrument(path: PathLike, unit: Optional[str] = None, channel: Optiona
         path: the file.
         unit: length unit of the returned map (None: the file's).
         channel: data channel index (None: the format's default).
+        allow_steep: skip :func:`check_units_plausible` (a genuinely steep surface).
         **surface_topography_kwargs: passed to ``SurfaceTopography.read_topography`` for files
             lacking metadata, e.g. ``physical_sizes=(Lx, Ly)``, ``unit="um"``,
             ``height_scale_factor``.
@@ -744,7 +839,7 @@ def read_instrument(path: PathLike, unit: Optional[str] = None, channel: Optiona
     h = np.ma.filled(h.astype(float), np.nan) if np.ma.isMaskedArray(h) else np.asarray(h, float)
     dx, dy = (float(v) for v in topo.pixel_size)
     # SurfaceTopography stores heights (nx, ny), axis 0 along x: transpose to (ny, nx)
-    hm = _finish(h.T * factor, dx * factor, dy * factor, ours, None, path)
+    hm = _finish(h.T * factor, dx * factor, dy * factor, ours, None, path, allow_steep)
     return hm if unit is None else hm.to_unit(unit)
 
 
@@ -756,7 +851,9 @@ def read_height_map(path: PathLike, **kwargs) -> HeightMap:
 
     ``.npy`` -> :func:`read_npy`; ``.csv``, ``.txt``, ``.dat`` -> :func:`read_text_grid`;
     ``.xyz`` -> :func:`read_xyz`; anything else -> :func:`read_instrument` (SurfaceTopography).
-    Keyword arguments go to that reader.
+    Keyword arguments go to that reader. Every reader refuses a map whose rms slope or
+    curvature is implausible for the stated units (:func:`check_units_plausible`, e.g. x, y in
+    mm read as um); ``allow_steep=True`` accepts a genuinely steep surface.
     """
     kind = _FORMATS.get(Path(path).suffix.lower(), "instrument")
     reader = {"npy": read_npy, "text": read_text_grid, "xyz": read_xyz,

@@ -332,3 +332,47 @@ def test_binary_file_with_a_text_suffix_names_the_file(tmp_path, suffix):
     path.write_bytes(bytes(range(128, 256)) * 8)
     with pytest.raises(ValueError, match=rf"scan\{suffix} is not a text file"):
         read_height_map(path, dx=1e-3, dy=1e-3) if suffix == ".csv" else read_height_map(path)
+
+
+# ----------------------------------------------------------------------------------------------
+# issue 24, item 5: implausible slopes for the stated units
+# ----------------------------------------------------------------------------------------------
+def test_lateral_units_mixed_up_are_refused_with_the_likely_cause(tmp_path, table1_map,
+                                                                  table1_psd):
+    """x, y in mm read as um multiply every slope by 1000: refused, naming the mix-up and the
+    override (before the fix the map was accepted with rms slopes of tens of rad)."""
+    hm = HeightMap(table1_map.heights[:64, :64], 2.0, 2.0, "um")
+    # the reference slope, by a route that shares nothing with the check: the spectrum's own
+    # moments (rms slope sqrt(m20), sqrt(m02) of Table 1 in the map axes, 0.01-0.03)
+    assert math.sqrt(max(TABLE1["m20"], TABLE1["m02"])) < 0.03
+    X, Y = np.meshgrid(hm.x * 1e-3, hm.y * 1e-3)                       # x, y in mm, z in um
+    np.savetxt(tmp_path / "surface.xyz", np.stack([X.ravel(), Y.ravel(),
+                                                   hm.heights.ravel()], 1), fmt="%.12g")
+    ok = read_height_map(tmp_path / "surface.xyz", unit="mm", height_unit="um")
+    assert ok.unit == "mm"
+    with pytest.raises(ValueError, match=r"rms slope .* rad .* implausible for a machined surface "
+                       r"\(expected < ~1.*lateral units mm rather than um.*allow_steep=True"):
+        read_height_map(tmp_path / "surface.xyz", unit="um", height_unit="um")
+    # the slopes the user would have got are ~1000x the true ones: tens of rad
+    steep = read_height_map(tmp_path / "surface.xyz", unit="um", height_unit="um",
+                            allow_steep=True)
+    from rough_contact.surface.topography import check_units_plausible
+    # the slopes and curvatures the check measures are the spectrum's (map axes, closed form;
+    # central differences at 2 um pixels read them 2-7 % low)
+    m = table1_psd.moments()
+    got = check_units_plausible(table1_map)
+    want = [math.sqrt(m.m20), math.sqrt(m.m02), math.sqrt(m.m40) * 1e-3, math.sqrt(m.m04) * 1e-3]
+    np.testing.assert_allclose(got, want, rtol=0.1)
+    with pytest.raises(ValueError, match="rms slope"):
+        check_units_plausible(steep)
+    assert steep.dx == pytest.approx(ok.dx, rel=1e-9)                    # same numbers, unit um
+    # heights in um stated as mm: the other mix-up is named
+    np.savetxt(tmp_path / "h.csv", hm.heights, delimiter=",")
+    with pytest.raises(ValueError, match="heights in um rather than mm"):
+        read_text_grid(tmp_path / "h.csv", dx=2.0, unit="um", height_unit="mm")
+    assert read_text_grid(tmp_path / "h.csv", dx=2.0, unit="um").unit == "um"
+    # every length in nm although the map is in mm: curvature radii far below an atom
+    np.save(tmp_path / "all.npy", hm.heights * 1e-3)
+    with pytest.raises(ValueError, match=r"rms curvature .* radius of .* nm, is implausible"):
+        read_npy(tmp_path / "all.npy", dx=2e-3, unit="nm")
+    assert read_npy(tmp_path / "all.npy", dx=2e-3, unit="mm").unit == "mm"
