@@ -295,10 +295,11 @@ def _short(c: Choice) -> str:
                     f"{_p_max(c):.3g} MPa)")
         return f"plasticity matters (e-p differs by {d.largest:.1%})"
     if c.name == "anisotropy":
-        if c.picked == c.simple and d is not None:
-            return f"isotropic equivalent suffices (differs by <= {d.largest:.1%})"
+        if c.picked == c.simple and "outside its validity" in c.reason:
+            return ("isotropic equivalent (anisotropic model outside its validity"
+                    + ("" if d is None else f"; they differ by {d.largest:.1%}") + ")")
         if c.picked == c.simple:
-            return "isotropic equivalent (anisotropic model outside its validity)"
+            return f"isotropic equivalent suffices (differs by <= {d.largest:.1%})"
         if d is None:
             return "anisotropic model kept (no isotropic elasto-plastic law)"
         q = max((("k", d.stiffness), ("A/A0", d.area), ("approach", d.approach)),
