@@ -80,6 +80,14 @@ def parse_args(argv):
     parser.add_argument("--hardness", default="psi", choices=["psi", "tabor"],
                         help="elasto-plastic asperity hardness: from psi = 0.35 (default) or "
                         "H = Y/0.354")
+    parser.add_argument("--law", default="table4", choices=["table4", "auto"],
+                        help="normal law: each case's own (Table 4), or auto: the law advisor "
+                        "picks the cheapest within --tolerance of the full model for the case's "
+                        "surface (report printed and written to OUTDIR/caseN/advice.txt, "
+                        "advice.json; docs/advisor.md)")
+    parser.add_argument("--tolerance", type=float, default=0.05,
+                        help="--law auto: accepted relative difference from the full model in "
+                        "k, A/A0 and interface approach")
     parser.add_argument("--outdir", default="results/beam")
     parser.add_argument("--figdir", default=None, help="also copy the figures here "
                         "(e.g. docs/figures)")
@@ -101,5 +109,6 @@ if __name__ == "__main__":
         order=args.order, load_half_length=args.load_half_length, steps=args.steps,
         tangential=args.tangential, friction=args.friction, hardness=args.hardness,
         outdir=args.outdir, figdir=args.figdir, fig_suffix=args.fig_suffix,
-        dof_threshold=args.dof_threshold, xdmf=not args.no_xdmf, overwrite=True)
+        dof_threshold=args.dof_threshold, xdmf=not args.no_xdmf, overwrite=True, law=args.law,
+        tolerance=args.tolerance)
 

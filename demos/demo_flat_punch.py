@@ -61,7 +61,14 @@ def parse_args(argv):
                         help="half-width of the central load patch on the punch top [mm]")
     parser.add_argument("--steps", type=int, default=16, help="loading increments")
     parser.add_argument("--no-unload", action="store_true")
-    parser.add_argument("--law", default="rough", choices=["rough", "penalty"])
+    parser.add_argument("--law", default="rough", choices=["rough", "penalty", "auto"],
+                        help="rough (the --normal-law given), a penalty stand-in, or auto: the "
+                        "law advisor picks the cheapest normal law within --tolerance of the "
+                        "full model over the run's pressures (report printed and written to "
+                        "OUTDIR/advice.txt, advice.json; docs/advisor.md)")
+    parser.add_argument("--tolerance", type=float, default=0.05,
+                        help="--law auto: accepted relative difference from the full model in "
+                        "k, A/A0 and interface approach")
     parser.add_argument("--case", default="b", choices=["a", "b", "c", "none"],
                         help="friction case of Fig 18")
     parser.add_argument("--normal-law", default="elasto-plastic",
@@ -97,5 +104,6 @@ if __name__ == "__main__":
         load_half_width=args.load_half_width, steps=args.steps, unload=not args.no_unload,
         law=args.law, case=args.case, normal_law=args.normal_law, outdir=args.outdir,
         dof_threshold=args.dof_threshold, overwrite=True, validity=args.validity,
-        checkpoint=args.checkpoint, restart=args.restart, stop_after=args.stop_after)
+        checkpoint=args.checkpoint, restart=args.restart, stop_after=args.stop_after,
+        tolerance=args.tolerance)
 

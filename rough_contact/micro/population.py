@@ -54,7 +54,8 @@ from .asperity import (AsperityMaterial, eccentricity_from_lambda, shape_factors
 from ..surface import SpectralMoments
 from ..validation import check_scalar
 
-__all__ = ["PopulationResult", "elastic", "elasto_plastic", "greenwood_williamson",
+__all__ = ["PopulationResult", "elastic", "elasto_plastic", "elasto_plastic_and_elastic",
+           "greenwood_williamson",
            "bearing_area", "bearing_area_ratio", "F_n", "log_F_n"]
 
 _L_WINDOW = 50.0   # window keeps integrand above exp(-50) of its maximum (p direction)
@@ -178,38 +179,48 @@ def _p_windows(l, k):
     window is where log G > max log G - 50; concavity with the -p^2/2 term bounds it to
     mode +- 10.
     """
-    def logG(p):
-        p = np.maximum(p, 1e-300)
-        return -0.5 * p * p + 3.0 * np.log(p) + log_F_n(1.0, l - k * p)
+    l2 = np.concatenate([l, l])
 
+    def logG(p):
+        ll = l if p.size == l.size else l2
+        p = np.maximum(p, 1e-300)
+        return -0.5 * p * p + 3.0 * np.log(p) + log_F_n(1.0, ll - k * p)
+
+    # Both points of a golden-section step, and both edges of the window, go through one call
+    # of logG (elementwise: the same numbers as separate calls, at half the calls; the fixed
+    # overhead of a call dominates for the few separations of a small table or the advisor).
+    n = l.size
     a = np.zeros_like(l)
     b = np.maximum(l, 0.0) / k + 6.0      # the mode lies below p_l + 3
     g = (math.sqrt(5.0) - 1.0) / 2.0
     for _ in range(100):                   # golden-section search of the mode
         c = b - g * (b - a)
         e = a + g * (b - a)
-        left = logG(c) > logG(e)
-        b = np.where(left, e, b)
-        a = np.where(left, a, c)
+        G = logG(np.concatenate([c, e]))
+        left = G[:n] > G[n:]
+        a_new = np.where(left, a, c)
+        b_new = np.where(left, e, b)
+        if np.array_equal(a_new, a) and np.array_equal(b_new, b):
+            break                          # a fixed point: further steps change nothing
+        a, b = a_new, b_new
     pm = 0.5 * (a + b)
-    target = logG(pm) - _L_WINDOW
+    target = np.concatenate([logG(pm) - _L_WINDOW] * 2)
     half = math.sqrt(2.0 * _L_WINDOW) + 1e-3
-    lo = np.maximum(pm - half, 0.0)
-    hi = pm.copy()
+    # lower edge in [pm - half, pm] (first n entries), upper edge in [pm, pm + half]
+    lo = np.concatenate([np.maximum(pm - half, 0.0), pm])
+    hi = np.concatenate([pm, pm + half])
+    lower = np.arange(2 * n) < n
     for _ in range(60):
         mid = 0.5 * (lo + hi)
         above = logG(mid) > target
-        hi = np.where(above, mid, hi)
-        lo = np.where(above, lo, mid)
-    pa = lo
-    lo = pm.copy()
-    hi = pm + half
-    for _ in range(60):
-        mid = 0.5 * (lo + hi)
-        above = logG(mid) > target
-        lo = np.where(above, mid, lo)
-        hi = np.where(above, hi, mid)
-    return pa, hi
+        # the lower edge moves down while above the target, the upper edge up
+        move_hi = above == lower
+        lo_new = np.where(move_hi, lo, mid)
+        hi_new = np.where(move_hi, mid, hi)
+        if np.array_equal(lo_new, lo) and np.array_equal(hi_new, hi):
+            break
+        lo, hi = lo_new, hi_new
+    return lo[:n], hi[n:]
 
 
 def _outer_nodes(surface: SpectralMoments, l, n_quad, n_p=None):
@@ -347,6 +358,25 @@ def elasto_plastic(surface: SpectralMoments, material: AsperityMaterial, h, n_qu
     Returns:
         PopulationResult with the regime split fields filled.
     """
+    return _elasto_plastic(surface, material, h, n_quad, elliptic, eccentricity, n_t, False)[0]
+
+
+def elasto_plastic_and_elastic(surface: SpectralMoments, material: AsperityMaterial, h,
+                               n_quad: int = 24, n_t: int | None = None):
+    """The elasto-plastic sums and the purely elastic ones on the same quadrature nodes.
+
+    The elastic result uses the elasto-plastic quadrature (inner t rule instead of the closed
+    forms of :func:`elastic`): with a coarse rule both carry nearly the same quadrature error,
+    which cancels in their ratio (what ``rough_contact.advisor`` compares). Arguments as in
+    :func:`elasto_plastic`.
+
+    Returns:
+        (elasto-plastic PopulationResult, elastic PopulationResult).
+    """
+    return _elasto_plastic(surface, material, h, n_quad, "exact", "exact", n_t, True)
+
+
+def _elasto_plastic(surface, material, h, n_quad, elliptic, eccentricity, n_t, elastic_too):
     mat = material.resolve(surface)
     n_quad = _check_nquad(n_quad)
     shape, l, smu, Ds = _separations(surface, h)
@@ -354,6 +384,7 @@ def elasto_plastic(surface: SpectralMoments, material: AsperityMaterial, h, n_qu
     pY = mat.yield_pressure
     slope = H * (ch - 2.0 * mat.K_nu / 3.0) / math.log(R)
     out = {k: np.zeros(l.size) for k in ("Ae", "At", "Ap", "We", "Wt", "Wp", "K")}
+    both = {k: np.zeros(l.size) for k in ("A", "W", "K")}   # all-elastic sums (elastic_too)
     n_t = max(16, (2 * n_quad) // 3) if n_t is None else _check_nquad(n_t)
     u, w = _gl01(n_t)
     # 1.5x more nodes along p: in deep contact the elastic/transition boundary of the flat
@@ -422,11 +453,17 @@ def elasto_plastic(surface: SpectralMoments, material: AsperityMaterial, h, n_qu
                          ("Wt", np.where(tr, W_tr, z)), ("Wp", np.where(pl, W_pl, z)),
                          ("K", np.where(el, k_el, np.where(pl, k_pl, k_tr)))):
             out[key][sl] += np.sum(ex * np.sum(val * wt, axis=-1), axis=(1, 2))
+        if elastic_too:
+            for key, val in (("A", A_el), ("W", W_el), ("K", k_el)):
+                both[key][sl] += np.sum(ex * np.sum(val * wt, axis=-1), axis=(1, 2))
     res = {k: (v * Ds).reshape(shape) for k, v in out.items()}
     A = res["Ae"] + res["At"] + res["Ap"]
     W = res["We"] + res["Wt"] + res["Wp"]
-    return PopulationResult(A, W, res["K"], res["Ae"], res["At"], res["Ap"],
-                            res["We"], res["Wt"], res["Wp"])
+    ep = PopulationResult(A, W, res["K"], res["Ae"], res["At"], res["Ap"],
+                          res["We"], res["Wt"], res["Wp"])
+    if not elastic_too:
+        return ep, None
+    return ep, PopulationResult(*((both[k] * Ds).reshape(shape) for k in ("A", "W", "K")))
 
 
 def greenwood_williamson(surface: SpectralMoments, E_star: float, h) -> PopulationResult:

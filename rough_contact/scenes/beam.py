@@ -99,6 +99,42 @@ def make_normal_law(comm, m00, normal_law, hardness="psi"):
     return comm.bcast(normal, root=0)
 
 
+def beam_material(hardness="psi", m00=None):
+    """Asperity material of the elasto-plastic cases (caption data, hardness as chosen)."""
+    from rough_contact.micro.asperity import AsperityMaterial
+
+    data = dict(PLASTIC)
+    if hardness == "tabor":
+        data.pop("psi")
+    return AsperityMaterial(E_star=E_STAR, nu=NU1, **data)
+
+
+# Peak over mean nominal pressure on the contact face assumed by the law advisor: the load acts on
+# a 10 mm strip at mid-length of a 500 mm beam, whose bending concentrates the pressure there.
+PRESSURE_CONCENTRATION = 10.0
+
+
+def advise_normal_law(comm, m00, hardness="psi", tolerance=0.05, surface=None, material=None):
+    """The law advisor's choice for the beam on Table 4's surface with variance m00 [um^2]
+    (nominal pressures from the seating pressure to PRESSURE_CONCENTRATION times the mean of
+    the full load) and the advised NormalLaw (rank 0 builds it). Collective.
+
+    Returns ``(advice, normal)``, the same on every rank."""
+    advice = normal = None
+    if comm.rank == 0:
+        from rough_contact.advisor import advise, scene_pressure_range
+        from rough_contact.surface import SpectralMoments
+
+        surface = surface or SpectralMoments(m00=m00, **MOMENTS_UM, unit="um")
+        material = material or beam_material(hardness)
+        area = 10.0 * 250.0          # half model's contact face [mm^2] (meshes/beam: 10 x 500)
+        p_range = scene_pressure_range(TOTAL_FORCE / 2.0, area, INITIAL_FORCE / 2.0 / area,
+                                       PRESSURE_CONCENTRATION)
+        advice = advise(surface, material, p_range, tolerance)
+        normal = advice.normal_law()
+    return comm.bcast(advice, root=0), comm.bcast(normal, root=0)
+
+
 def make_law(normal, m00, seating_pressure, tangential="mindlin", friction="b"):
     """Interface law: normal law + tangential stiffness (96) + slip-hardening friction."""
     from rough_contact.interface.friction import OrthotropicSlipHardening
@@ -370,16 +406,30 @@ def deflection_profile(comm, setup, uN_nodes, n_samples=251):
 # ## One case
 def run_case(comm, setup, case, steps=16, tangential="mindlin", friction="b", hardness="psi",
              outdir="results/beam", prefix="rc_", dof_threshold=None, verbose=True, xdmf=True,
-             beam_modulus=E1, overwrite=False):
+             beam_modulus=E1, overwrite=False, law="table4", tolerance=0.05):
     """Load one Table 4 case; return its :class:`BeamCaseResult`. Collective.
 
     Identical on every rank except the point arrays ``points_y``, ``points_p``, ``points_uN``
     (interface quadrature points, sorted by y), present on rank 0 only. Lengths in mm,
-    pressures in MPa, forces in N.
+    pressures in MPa, forces in N. ``law="auto"``: the law advisor picks the case surface's
+    normal law (cheapest within ``tolerance`` of the full model); its report is printed and
+    written to the case's folder (advice.txt, advice.json).
     """
     t0 = MPI.Wtime()
     m00, normal_law = CASES[case]
-    normal = make_normal_law(comm, m00, normal_law, hardness)
+    if law not in ("table4", "auto"):
+        raise ValueError(f"law = {law!r} is invalid; valid values: 'table4', 'auto'")
+    if law == "auto":
+        advice, normal = advise_normal_law(comm, m00, hardness, tolerance)
+        PETSc.Sys.Print(f"\nCase {case}: " + advice.report(), comm=comm)
+        if comm.rank == 0:
+            case_dir = os.path.join(outdir, f"case{case}")
+            os.makedirs(case_dir, exist_ok=True)
+            atomic_write_text(os.path.join(case_dir, "advice.txt"), advice.report() + "\n")
+            atomic_write_text(os.path.join(case_dir, "advice.json"), advice.to_json() + "\n")
+        normal_law = advice.normal
+    else:
+        normal = make_normal_law(comm, m00, normal_law, hardness)
     t_law = MPI.Wtime() - t0
     c = build_case(setup, normal, m00, steps, tangential, friction, prefix, dof_threshold,
                    beam_modulus)
@@ -543,7 +593,7 @@ def run(cases=tuple(sorted(CASES)), mesh_size=40.0, contact_size=5.0, order=2,
          load_half_length=5.0, steps=16, tangential="mindlin", friction="b", hardness="psi",
          outdir="results/beam", figdir=None, fig_suffix="", prefix="rc_", dof_threshold=None,
          comm=MPI.COMM_WORLD, verbose=True, plot=True, xdmf=True, beam_modulus=E1,
-         overwrite=False):
+         overwrite=False, law="table4", tolerance=0.05):
     """Run the chosen Table 4 cases; return a list of :class:`BeamCaseResult` (same on every
     rank but the rank-0 point arrays).
 
@@ -566,6 +616,8 @@ def run(cases=tuple(sorted(CASES)), mesh_size=40.0, contact_size=5.0, order=2,
         beam_modulus: Young's modulus of the beam's bulk [MPa] (the paper's E1 by default; the
             interface law keeps E* of the paper). A very large value gives the rigid-beam
             limit, a check of the whole chain against the normal law alone.
+        law: "table4" (each case's own normal law) or "auto" (the law advisor's choice
+            within ``tolerance`` for each case's surface; the case number then selects m00).
 
     Returns:
         list of :class:`BeamCaseResult`, one per case (see :func:`run_case`).
@@ -587,7 +639,8 @@ def run(cases=tuple(sorted(CASES)), mesh_size=40.0, contact_size=5.0, order=2,
     results = []
     for case in cases:
         results.append(run_case(comm, setup, case, steps, tangential, friction, hardness, outdir,
-                                prefix, dof_threshold, verbose, xdmf, beam_modulus, overwrite))
+                                prefix, dof_threshold, verbose, xdmf, beam_modulus, overwrite,
+                                law, tolerance))
     text = table(results)
     PETSc.Sys.Print("\n" + text + f"\n\nTotal wall time {MPI.Wtime() - t0:.1f} s on "
                     f"{comm.size} rank(s)", comm=comm)

@@ -44,7 +44,7 @@ from rough_contact.solver.snes import SNESSolver
 from rough_contact.validation import check_scalar
 
 __all__ = ["E", "NU", "TOTAL_FORCE", "MOMENTS_UM", "FRICTION_CASES", "HARDENING", "TABLE5",
-           "PLASTIC", "effective_modulus", "make_law", "PunchScene", "quarter_punch", "PunchModel",
+           "PLASTIC", "NORMAL_LAWS", "effective_modulus", "make_law", "advise_law", "write_advice", "PunchScene", "quarter_punch", "PunchModel",
            "build", "point_data", "plot_slip_directions", "PunchResult", "run"]
 
 # Silence the INFO lines of the JIT compiler (setuptools resets the root logger's level).
@@ -90,9 +90,9 @@ def make_law(comm, law="rough", case="b", normal_law="elastic", seating_pressure
         raise ValueError(f"law = {law!r} is invalid; valid values: 'rough', 'penalty'")
     if case not in FRICTION_CASES and case != "none":
         raise ValueError(f"friction case = {case!r} is invalid; valid: a, b, c, none")
-    if normal_law not in ("elastic", "elasto-plastic"):  # checked on every rank: no hang
+    if normal is None and normal_law not in NORMAL_LAWS:  # checked on every rank: no hang
         raise ValueError(f"normal_law = {normal_law!r} is invalid; valid values: "
-                         "'elastic', 'elasto-plastic'")
+                         f"{', '.join(repr(n) for n in NORMAL_LAWS)} (or 'auto' in run)")
     if normal is None:
         if comm.rank == 0:  # the table is built once and copied to the other ranks
             from rough_contact.micro.asperity import AsperityMaterial
@@ -103,6 +103,8 @@ def make_law(comm, law="rough", case="b", normal_law="elastic", seating_pressure
             E_star = effective_modulus(E, NU, E, NU)
             if normal_law == "elastic":
                 normal = NormalLaw.elastic(surface, E_star)
+            elif normal_law == "greenwood_williamson":
+                normal = NormalLaw.greenwood_williamson(surface, E_star)
             else:
                 normal = NormalLaw.elasto_plastic(
                     surface, AsperityMaterial(E_star=E_star, nu=NU, **PLASTIC))
@@ -118,6 +120,46 @@ def make_law(comm, law="rough", case="b", normal_law="elastic", seating_pressure
         rough = InterfaceLaw(normal=normal, tangential=TangentialStiffness(kt),
                              friction=friction)
     return rough.with_seating(seating_pressure), normal
+
+
+NORMAL_LAWS = ("elastic", "elasto-plastic", "greenwood_williamson")
+
+
+# ## The law advisor (``normal_law="auto"``)
+#
+# The scene's nominal pressures run from the seating pressure (the first increment) to twice the
+# mean pressure under the punch (the pressure rises towards the punch's edges); the advisor
+# (rough_contact.advisor) picks the cheapest normal law within the tolerance over that range.
+def advise_law(comm, tolerance=0.05, steps=16, total_force=TOTAL_FORCE, half_width=10.0,
+               concentration=2.0, surface=None, material=None):
+    """The advisor's choice for the punch, and the advised NormalLaw (built on rank 0, copied
+    to the others). Collective. Returns ``(advice, normal)``, the same on every rank."""
+    advice = normal = None
+    if comm.rank == 0:
+        from rough_contact.advisor import advise, scene_pressure_range
+        from rough_contact.micro.asperity import AsperityMaterial
+        from rough_contact.surface import SpectralMoments
+
+        surface = surface or SpectralMoments(**MOMENTS_UM, unit="um")
+        E_star = effective_modulus(E, NU, E, NU)
+        material = material or AsperityMaterial(E_star=E_star, nu=NU, **PLASTIC)
+        quarter = total_force / 4.0
+        area = half_width ** 2
+        p_range = scene_pressure_range(quarter, area, quarter / steps / area, concentration)
+        advice = advise(surface, material, p_range, tolerance)
+        normal = advice.normal_law()
+    return comm.bcast(advice, root=0), comm.bcast(normal, root=0)
+
+
+def write_advice(comm, advice, outdir):
+    """advice.txt and advice.json beside the results (rank 0, atomic writes)."""
+    if comm.rank == 0:
+        from rough_contact.io import atomic_write_text
+
+        os.makedirs(outdir, exist_ok=True)
+        atomic_write_text(os.path.join(outdir, "advice.txt"), advice.report() + "\n")
+        atomic_write_text(os.path.join(outdir, "advice.json"), advice.to_json() + "\n")
+    comm.barrier()
 
 
 # ## Scene, spaces, conditions, problem
@@ -305,7 +347,8 @@ class PunchResult:
 def run(mesh_size=20.0, contact_size=2.0, order=2, load_half_width=2.5, steps=16,
          unload=True, law="rough", case="b", normal_law="elasto-plastic", outdir="results/flat_punch",
          prefix="rc_", dof_threshold=None, comm=MPI.COMM_WORLD, verbose=True, plot=True,
-         overwrite=False, validity="warn", checkpoint=None, restart=None, stop_after=None):
+         overwrite=False, validity="warn", checkpoint=None, restart=None, stop_after=None,
+         tolerance=0.05):
     """Run the punch; return a :class:`PunchResult` (identical on every rank). Collective.
 
     ``outdir`` receives one run: earlier results there make it refuse unless ``overwrite``.
@@ -316,10 +359,21 @@ def run(mesh_size=20.0, contact_size=2.0, order=2, load_half_width=2.5, steps=16
     from (``rough_contact.solver.checkpoint``); the output files in ``outdir`` (the stopped
     run's) are cut back to the checkpoint and continued. ``stop_after``: stop after this many
     increments (checkpoint written), to continue later with ``restart``.
+    ``normal_law="auto"`` (or ``law="auto"``): the law advisor picks the cheapest normal law
+    within ``tolerance`` of the full model over the run's pressures; its report is printed and
+    written beside the results (advice.txt, advice.json).
     """
     t0 = MPI.Wtime()
+    normal = None
+    if law == "auto":
+        law, normal_law = "rough", "auto"
+    if normal_law == "auto" and law == "rough":
+        advice, normal = advise_law(comm, tolerance, steps)
+        PETSc.Sys.Print(advice.report(), comm=comm)
+        write_advice(comm, advice, outdir)
+        normal_law = advice.normal
     m = build(comm, mesh_size, contact_size, order, load_half_width, law, case, normal_law,
-              steps, prefix, dof_threshold)
+              steps, prefix, dof_threshold, normal=normal)
     problem, solver, interface = m.problem, m.solver, m.interface
     n_points = interface.n_points_global
     PETSc.Sys.Print(f"Flat punch (quarter): {problem.num_dofs} DOFs, {n_points} interface points, "

@@ -50,6 +50,34 @@ def test_demo_flat_punch(tmp_path, ranks):
     assert (tmp_path / "punch" / "history.csv").exists()
 
 
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_demo_flat_punch_law_auto(tmp_path, ranks):
+    """--law auto: the advisor's report printed at the start and written beside the results."""
+    if ranks > 1 and MPIRUN is None:
+        pytest.skip("mpirun not found")
+    small = [a for a in PUNCH_SMALL if a not in ("--normal-law", "elastic")]
+    out = run([DEMOS / "demo_flat_punch.py", *small, "--law", "auto", "--outdir",
+               tmp_path / "punch", "-rc_snes_rtol", "1e-9"], tmp_path, ranks)
+    assert out.index("Law advice") < out.index("Flat punch (quarter)")
+    assert "advised normal law:" in out and "Force balance" in out
+    text = (tmp_path / "punch" / "advice.txt").read_text()
+    assert text.startswith("Law advice") and "plasticity" in text
+    import json
+    data = json.loads((tmp_path / "punch" / "advice.json").read_text())
+    # the demo's asperity data (Y = 2070 MPa, K_Y = 1.62, psi = 0.35) make the e-p law differ
+    assert data["normal"] == "elasto-plastic"
+    assert f"law=rough ({data['normal']}" in out
+
+
+def test_demo_beam_law_auto(tmp_path):
+    out = run([DEMOS / "demo_beam_rigid_base.py", "--cases", "1", "--mesh-size", "80",
+               "--contact-size", "20", "--order", "1", "--steps", "2", "--no-xdmf",
+               "--law", "auto", "--outdir", tmp_path / "beam"], tmp_path)
+    assert out.index("Law advice") < out.index("| 1 | 0.625 |")
+    assert (tmp_path / "beam" / "case1" / "advice.txt").read_text().startswith("Law advice")
+    assert (tmp_path / "beam" / "case1" / "advice.json").exists()
+
+
 def test_demo_flat_punch_rejects_bad_options(tmp_path):
     env = dict(os.environ, MPLBACKEND="Agg")
     for args, words in ((["--steps", "0"], "steps = 0"), (["--mesh-size", "-1"], "mesh_size"),

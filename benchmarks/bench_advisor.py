@@ -1,0 +1,215 @@
+"""The law advisor on the punch and beam scenes: full model vs advised law, five surfaces.
+
+For each surface (the paper's Table 1 and Table 2 surfaces, a nearly isotropic one, a high
+plasticity index one, a heavily loaded one beyond 10 % real area) and each scene (the quarter
+flat punch of section 9.2, the half beam of section 9.1; coarse P1 meshes), the advisor
+(rough_contact.advisor.advise, tolerance 5 %) picks a normal law over the scene's pressure range;
+the scene then runs with the full model (the fullest statistical law that applies to the surface,
+``Advice.full_normal``) and with the advised law, and the table compares their FE results:
+
+* force distribution: max over the interface points of |p_adv - p_full| / max p_full at the peak
+  load (same mesh, same points);
+* real contact area: sum of w A/A0 over the points at the peak;
+* dissipation: total frictional dissipation at the end of the path (punch: load and unload);
+* approach: area-weighted mean change of the interface gap from the first increment to the peak.
+
+The next cheaper law, which the advisor refused, is run as well; its largest FE difference from
+the full model (last column) shows whether the refusal was needed.
+
+Wall times: the law's table build and the FE solve of each run, and the advisor's own time with
+its ratio to the cheapest table build of the same surface (the elastic anisotropic table, the
+cheapest one that needs the population integral; McCool's GW table is a closed form).
+
+    OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bench_advisor.py [--tolerance 0.05]
+        [--surfaces ...] [--scenes punch beam] [--csv FILE]
+
+Units: mm, N, MPa.
+"""
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+import time
+import warnings
+
+import petsc4py
+from _common import write_csv
+
+petsc4py.init(sys.argv)
+
+import numpy as np  # noqa: E402
+from mpi4py import MPI  # noqa: E402
+
+from rough_contact.advisor import advise, scene_pressure_range  # noqa: E402
+from rough_contact.interface.normal import NormalLaw  # noqa: E402
+from rough_contact.micro.asperity import AsperityMaterial  # noqa: E402
+from rough_contact.scenes import beam, flat_punch  # noqa: E402
+from rough_contact.solver.loading import load_path, load_unload_factors  # noqa: E402
+from rough_contact.surface import SpectralMoments, example_surfaces  # noqa: E402
+
+TABLE1 = dict(m00=0.625, m20=8e-5, m02=8e-4, m40=1.04e-6, m04=1.04e-4)
+TABLE2 = dict(m00=3.0, m20=1.0, m02=81.0, m40=1.0, m04=6561.0)
+CAPTION = dict(Y=2070.0, K_Y=1.62, psi=0.35, ch=0.967, omega_p_ratio=45.0)   # Figs 18-19
+
+
+def _scaled(m: SpectralMoments, c: float) -> SpectralMoments:
+    """Heights times c: every moment times c^2 (bandwidths unchanged)."""
+    return SpectralMoments(m.m00 * c * c, m.m20 * c * c, m.m02 * c * c, m.m40 * c * c,
+                           m.m04 * c * c, unit="mm")
+
+
+def surfaces():
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)
+        aniso = example_surfaces()["anisotropic"][0]
+        return {
+            "Table 1 (paper, caption data)": (SpectralMoments(**TABLE1, unit="um"), CAPTION),
+            "Table 2 (paper), psi 0.35": (SpectralMoments(**TABLE2, unit="um"), dict(psi=0.35)),
+            "nearly isotropic, psi 0.35": (SpectralMoments(m00=0.625, m20=8e-4, m02=8.4e-4,
+                                                           m40=1.04e-4, m04=1.092e-4),
+                                           dict(psi=0.35)),
+            "Table 1, psi 5": (SpectralMoments(**TABLE1, unit="um"), dict(psi=5.0)),
+            "heavily loaded (narrow band, heights x 0.009)": (_scaled(aniso, 0.009),
+                                                             dict(psi=0.35)),
+            # the project's reading K_Y Y = (2/pi) H: no asperity yields at these loads
+            "Table 1 (paper), psi 0.35, (2/pi) H": (SpectralMoments(**TABLE1, unit="um"),
+                                                   dict(psi=0.35)),
+        }
+
+
+def build_normal(advice, law):
+    t = time.perf_counter()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)
+        kw = dict(n_realisations=2) if law == "bem" else {}
+        normal = advice.normal_law(law, **kw)
+    return normal, time.perf_counter() - t
+
+
+# ## scenes: one run with a given normal law -> FE results
+def run_punch(normal, comm, steps=4):
+    m = flat_punch.build(comm, mesh_size=20.0, contact_size=2.5, order=1, normal=normal,
+                         normal_law="elastic", steps=steps, prefix="adv_punch_")
+    return _run(m.problem, m.solver, m.interface, load_unload_factors(steps, steps // 2), comm)
+
+
+def run_beam(normal, comm, setup, steps=4):
+    c = beam.build_case(setup, normal, 0.625, steps=steps, prefix="adv_beam_")
+    return _run(c.problem, c.solver, c.interface, c.factors, comm)
+
+
+def _run(problem, solver, interface, factors, comm):
+    t = time.perf_counter()
+    first = peak = None
+    for inc in load_path(problem, solver, factors, verbose=False, validity="ignore"):
+        pf = interface.point_fields()
+        if first is None:
+            first = pf.gap.copy()
+        if inc.load_factor == max(factors) and peak is None:
+            w = interface.point_weights()
+            peak = dict(p=pf.pressure.copy(),
+                        area=comm.allreduce(float(np.dot(w, pf.area_fraction)), op=MPI.SUM),
+                        approach=comm.allreduce(float(np.dot(w, first - pf.gap)), op=MPI.SUM)
+                        / interface.nominal_area())
+    out = dict(peak, dissipation=interface.dissipation(), seconds=time.perf_counter() - t)
+    solver.destroy()
+    return out
+
+
+def compare(full, adv):
+    pmax = max(float(np.max(full["p"])), 1e-300)
+    rel = (lambda a, b: abs(a / b - 1.0) if b != 0 else (0.0 if a == 0 else math.inf))
+    return dict(force=float(np.max(np.abs(adv["p"] - full["p"]))) / pmax,
+                area=rel(adv["area"], full["area"]),
+                dissipation=rel(adv["dissipation"], full["dissipation"]),
+                approach=rel(adv["approach"], full["approach"]))
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0], allow_abbrev=False)
+    ap.add_argument("--tolerance", type=float, default=0.05)
+    ap.add_argument("--surfaces", type=int, nargs="+", default=None,
+                    help="indices (0-5) of the surfaces to run (default all)")
+    ap.add_argument("--scenes", nargs="+", default=["punch", "beam"], choices=["punch", "beam"])
+    ap.add_argument("--csv", default=None)
+    args, _ = ap.parse_known_args(argv)
+    comm = MPI.COMM_WORLD
+    cases = list(surfaces().items())
+    if args.surfaces is not None:
+        cases = [cases[i] for i in args.surfaces]
+    setup = beam.build_scene(comm, mesh_size=80.0, contact_size=20.0, order=1) \
+        if "beam" in args.scenes else None
+    E_punch = flat_punch.effective_modulus(flat_punch.E, flat_punch.NU, flat_punch.E,
+                                           flat_punch.NU)
+    scenes = {"punch": (E_punch, flat_punch.NU,
+                        scene_pressure_range(250.0, 100.0, 250.0 / 16 / 100.0, 2.0)),
+              "beam": (beam.E_STAR, beam.NU1,
+                       scene_pressure_range(beam.TOTAL_FORCE / 2, 2500.0,
+                                            beam.INITIAL_FORCE / 2 / 2500.0,
+                                            beam.PRESSURE_CONCENTRATION))}
+    rows = []
+    for name, (surface, mdata) in cases:
+        for scene in args.scenes:
+            E, nu, p_range = scenes[scene]
+            material = AsperityMaterial(E_star=E, nu=nu, **mdata)
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", UserWarning)
+                advice = advise(surface, material, p_range, args.tolerance)
+                t = time.perf_counter()
+                NormalLaw.elastic(surface, E)
+                t_el = time.perf_counter() - t
+            print(f"\n## {name}, {scene}\n{advice.report()}", flush=True)
+            full_law, adv_law = advice.full_normal, advice.normal
+            n_full, tb_full = build_normal(advice, full_law)
+            res_full = (run_punch(n_full, comm) if scene == "punch"
+                        else run_beam(n_full, comm, setup))
+            if adv_law == full_law:
+                n_adv, tb_adv, res_adv = n_full, tb_full, res_full
+            else:
+                n_adv, tb_adv = build_normal(advice, adv_law)
+                res_adv = (run_punch(n_adv, comm) if scene == "punch"
+                           else run_beam(n_adv, comm, setup))
+            d = compare(res_full, res_adv)
+            # the next cheaper law the advisor refused, run too: its FE difference from the full
+            # model shows whether the refusal was needed
+            cheaper = {"elasto-plastic": "elastic", "bem": "elastic",
+                       "elastic": "greenwood_williamson"}.get(adv_law)
+            refused = None
+            if cheaper is not None and cheaper != full_law:
+                n_ch, _ = build_normal(advice, cheaper)
+                res_ch = (run_punch(n_ch, comm) if scene == "punch"
+                          else run_beam(n_ch, comm, setup))
+                refused = (cheaper, max(compare(res_full, res_ch).values()))
+            est = {c.law: c.build_seconds for c in advice.costs}
+            row = dict(surface=name, scene=scene, p_range=f"{p_range[0]:.3g}-{p_range[1]:.3g}",
+                       full=full_law, advised=adv_law, A_max=advice.max_area_fraction,
+                       force=d["force"], area=d["area"], dissipation=d["dissipation"],
+                       approach=d["approach"], build_full=tb_full, build_adv=tb_adv,
+                       est_full=est.get(full_law), est_adv=est.get(adv_law),
+                       fe_full=res_full["seconds"], fe_adv=res_adv["seconds"],
+                       saved=(tb_full + res_full["seconds"]) - (tb_adv + res_adv["seconds"]),
+                       advisor=advice.advisor_seconds, elastic_build=t_el,
+                       advisor_ratio=advice.advisor_seconds / t_el,
+                       refused=refused[0] if refused else "-",
+                       refused_difference=refused[1] if refused else float("nan"))
+            rows.append(row)
+            print(f"-> {row}", flush=True)
+    print("\n| surface | scene | p range [MPa] | full | advised | max A/A0 | force distr. "
+          "| real area | dissipation | approach | build full / advised [s] | FE full / advised "
+          "[s] | saved [s] | advisor [ms] (/ elastic build) | cheaper law refused: its largest FE "
+          "difference |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+    for r in rows:
+        print(f"| {r['surface']} | {r['scene']} | {r['p_range']} | {r['full']} | {r['advised']} "
+              f"| {r['A_max']:.2%} | {r['force']:.2%} | {r['area']:.2%} "
+              f"| {r['dissipation']:.2%} | {r['approach']:.2%} "
+              f"| {r['build_full']:.2f} / {r['build_adv']:.2f} | {r['fe_full']:.1f} / "
+              f"{r['fe_adv']:.1f} | {r['saved']:.1f} | {r['advisor'] * 1e3:.0f} "
+              f"({r['advisor_ratio']:.0%}) | {r['refused']}: {r['refused_difference']:.1%} |")
+    if args.csv:
+        write_csv(args.csv, rows)
+
+
+if __name__ == "__main__":
+    main()
