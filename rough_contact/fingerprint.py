@@ -159,7 +159,8 @@ def differences(saved: Any, now: Any, limit: int = 8) -> List[str]:
             out.append(f"{k[:-4] or '(top)'}: {a.get(k)} entries in the checkpoint, "
                        f"{b.get(k)} now")
         else:
-            out.append(f"{k or '(top)'}: {_show(a.get(k))} in the checkpoint, {_show(b.get(k))} now")
+            out.append(f"{k or '(top)'}: {_show(a.get(k))} in the checkpoint, "
+                       f"{_show(b.get(k))} now")
     if len(out) > limit:
         out = out[:limit] + [f"and {len(out) - limit} more"]
     return out

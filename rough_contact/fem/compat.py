@@ -29,8 +29,8 @@ import dolfinx.la
 import dolfinx.mesh
 
 __all__ = ["DOLFINX_VERSION", "NEW_API", "vector_space", "petsc_vector", "function_values", "interpolate",
-           "element_degree", "geometry_degree", "geometry_dofmap", "cell_dofmap", "node_input_indices",
-           "geometry_input_indices",
+           "element_degree", "geometry_degree", "geometry_dofmap", "cell_dofmap",
+           "node_input_indices", "geometry_input_indices",
            "create_petsc_vector", "form_sparsity", "block_csr_matrix", "near_nullspace",
            "mesh_domain", "create_mesh", "meshtags_from_arrays", "facet_geometry_nodes",
            "set_bc", "apply_lifting", "write_meshtags", "DirichletBC"]
