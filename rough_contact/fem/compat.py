@@ -15,7 +15,7 @@ Units: none (pure plumbing).
 
 from __future__ import annotations
 
-from typing import Sequence
+from typing import Optional, Sequence
 
 import numpy as np
 
@@ -30,6 +30,7 @@ import dolfinx.mesh
 
 __all__ = ["DOLFINX_VERSION", "NEW_API", "vector_space", "petsc_vector", "function_values", "interpolate",
            "element_degree", "geometry_degree", "geometry_dofmap", "cell_dofmap",
+           "node_input_indices", "geometry_input_indices",
            "create_petsc_vector", "form_sparsity", "block_csr_matrix", "near_nullspace",
            "mesh_domain", "create_mesh", "meshtags_from_arrays", "facet_geometry_nodes",
            "set_bc", "apply_lifting", "write_meshtags", "DirichletBC"]
@@ -88,6 +89,37 @@ def geometry_dofmap(mesh) -> np.ndarray:
     """(n_cells, n_geometry_nodes) geometry node indices of every local cell."""
     dm = mesh.geometry.dofmap
     return np.asarray(dm) if NEW_API else dm.array.reshape(dm.num_nodes, -1)
+
+
+def node_input_indices(V) -> Optional[np.ndarray]:
+    """(n_local_nodes,) int64: for every node of ``V`` on this rank (owned, then ghost), the
+    index of its geometry node in the arrays the mesh was built from (``input_global_indices``:
+    the same for every partition and number of ranks); None when ``V``'s nodes are not the
+    geometry's (another degree or layout: checked on the coordinates)."""
+    msh = V.mesh
+    if element_degree(V) != geometry_degree(msh):
+        return None
+    dofs, geo = cell_dofmap(V), geometry_dofmap(msh)
+    imap = V.dofmap.index_map
+    n = imap.size_local + imap.num_ghosts
+    if dofs.shape != geo.shape:
+        return None
+    out = np.full(n, -1, dtype=np.int64)
+    out[dofs.reshape(-1)] = np.asarray(msh.geometry.input_global_indices,
+                                       dtype=np.int64)[geo.reshape(-1)]
+    x = V.tabulate_dof_coordinates()[dofs.reshape(-1)]
+    xg = msh.geometry.x[geo.reshape(-1)]
+    scale = max(1.0, float(np.abs(msh.geometry.x).max(initial=0.0)))
+    if np.any(out < 0) or not np.allclose(x, xg, rtol=0.0, atol=1e-12 * scale):
+        return None
+    return out
+
+
+def geometry_input_indices(msh) -> np.ndarray:
+    """(n_owned_geometry_nodes,) int64 input indices of this rank's owned geometry nodes, in
+    the order an XDMF file writes them."""
+    n = msh.geometry.index_map().size_local
+    return np.asarray(msh.geometry.input_global_indices, dtype=np.int64)[:n]
 
 
 def cell_dofmap(V) -> np.ndarray:

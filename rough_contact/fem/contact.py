@@ -55,6 +55,7 @@ from rough_contact.fem.interface_setup import (RigidPlane, check_arguments, chec
                                                initial_law_state, pair_auto, select_pairing,
                                                warn_overconstrained)
 from rough_contact.fem.jump import JumpOperator
+from rough_contact.fingerprint import describe
 from rough_contact.fem.pairing import Pairing, SlidingPairing, SurfaceContext
 from rough_contact.fem.pairing.facets import (FacetGeometry, FacetRule, facet_connectivity,
                                               owned_tagged_facets)
@@ -144,6 +145,8 @@ class ContactInterface(InterfaceQueries):
                                         quadrature_degree, grain_direction, quadrature)
         self.enforcement.check_law(law)
         self.first_tag, self.second_tag, self.sliding = first_tag, second_tag, sliding
+        self.grain_direction = tuple(float(g) for g in grain)
+        self.quadrature, self.quadrature_degree = quadrature, degree
         n_owned = facet_connectivity(V.mesh)
         rule = FacetRule.create(V.mesh, degree, vertex=quadrature == "vertex")
         if quadrature == "gauss":
@@ -346,6 +349,20 @@ class ContactInterface(InterfaceQueries):
         self._newton_memo = None
 
     # ------------------------------------------------------------------ checkpoints
+    def describe(self) -> dict:
+        """What defines this interface, as canonical plain data (``rough_contact.fingerprint``):
+        the law's parameters, the pairing (its options, the surfaces, the grain direction), the
+        quadrature rule and the enforcement; equal on every rank and for every rank count."""
+        return dict(
+            law=describe(self.law, "law"),
+            pairing=dict(describe(self.pairing, "pairing"), used=self.pairing_used,
+                         first_tag=int(self.first_tag), sliding=self.sliding,
+                         second_tag=None if self.second_tag is None else int(self.second_tag),
+                         grain_direction=describe(self.grain_direction)),
+            quadrature=dict(rule=self.quadrature, degree=int(self.quadrature_degree),
+                            points_per_facet=int(self.n_qp)),
+            enforcement=describe(self.enforcement, "enforcement"))
+
     def state(self) -> dict:
         """The interface's committed history (one picklable object for checkpoints)."""
         return self.history.state()

@@ -26,6 +26,7 @@ without any error.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from types import FunctionType
 from typing import Optional, Sequence
 
 import numpy as np
@@ -37,6 +38,7 @@ from petsc4py import PETSc
 
 from rough_contact.fem import compat
 from rough_contact.fem.contact import ContactInterface
+from rough_contact.fingerprint import describe
 from rough_contact.validation import check_scalar
 
 __all__ = ["Material", "SurfaceLoad", "PrescribedDisplacement", "ContactProblem",
@@ -239,6 +241,7 @@ class ContactProblem:
         self.V, self.mesh, self.comm = V, msh, msh.comm
         self.bcs = list(bcs)
         self.loads = list(loads)
+        self.prescribed = list(prescribed)
         self.interface = interface
         self.body_cells = [np.asarray(c, dtype=np.int32) for c in body_cells]
         self.load_factor = 0.0
@@ -280,6 +283,7 @@ class ContactProblem:
         self.u.x.scatter_forward()
         self.b = self.f.duplicate()
         self.counters = {"residual": 0, "jacobian": 0}
+        self._node_keys = False              # owned_node_keys, not computed yet
         self.callback_error: Optional[BaseException] = None   # see F
         self.timings = {"bulk": 0.0, "interface_residual": 0.0, "interface_jacobian": 0.0}
 
@@ -427,6 +431,15 @@ class ContactProblem:
     def local_solution_values(self) -> np.ndarray:
         """This rank's displacement values, owned and ghost (a view) [mm]."""
         return compat.function_values(self.u)
+
+    def owned_node_keys(self) -> Optional[np.ndarray]:
+        """(n_owned_nodes,) int64 keys of this rank's owned displacement nodes that do not
+        depend on the partition (the nodes' indices in the arrays the mesh was built from), or
+        None when the space's nodes are not the geometry's (``compat.node_input_indices``)."""
+        if self._node_keys is False:       # computed once: the mesh does not change
+            keys = compat.node_input_indices(self.V)
+            self._node_keys = None if keys is None else keys[: self.V.dofmap.index_map.size_local]
+        return self._node_keys
 
     def owned_dof_coordinates(self) -> np.ndarray:
         """(n_owned_nodes, 3) coordinates of this rank's owned displacement nodes [mm]."""
@@ -622,6 +635,31 @@ class ContactProblem:
                 total[c] += float(arr[np.asarray(dofs)[:n_owned]].sum())
         r.destroy()
         return self.comm.allreduce(total, op=MPI.SUM)
+
+    def describe(self, factors: Sequence[float]) -> dict:
+        """What defines this problem beyond its mesh, as canonical plain data
+        (``rough_contact.fingerprint``), equal on every rank and for every rank count: the
+        interface (law, pairing, quadrature, enforcement), the load program (the scale of every
+        load channel at each of ``factors``), the loads and prescribed displacements, and the
+        materials. A user's own forms (``forms=``) are not described."""
+        program = {}
+        for name in sorted(self.scales):
+            fn = self.programs.get(name)
+            program[name] = {f"t={float(t)!r}": repr(float(t if fn is None else fn(float(t))))
+                             for t in factors}
+        loads = [describe(x, "load") for x in self.loads]
+        prescribed = [dict(tag=int(p.tag), components=describe(p.components),
+                           channel=p.channel,
+                           value=describe(p.value, "prescribed value")
+                           if not callable(p.value) or isinstance(p.value, FunctionType)
+                           else f"{type(p.value).__qualname__} (values not recorded)")
+                      for p in self.prescribed]
+        return dict(
+            interface=None if self.interface is None else self.interface.describe(),
+            program=program, loads=dict(surface=loads, prescribed=prescribed),
+            materials=None if self._user_forms is not None else
+            {str(k): describe(m, "material") for k, m in sorted(self.materials.items(),
+                                                                key=lambda kv: str(kv[0]))})
 
     def reset_timings(self) -> None:
         for k in self.timings:

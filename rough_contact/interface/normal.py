@@ -127,7 +127,7 @@ class NormalLaw:
     _pe: float
     _ae: float
     _taper: float            # L [mm]
-    info: dict = field(default_factory=dict)
+    info: dict = field(default_factory=dict, compare=False)   # not part of its identity
 
     # ------------------------------------------------------------------ construction helpers
     @property

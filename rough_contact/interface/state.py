@@ -10,14 +10,16 @@ the dissipation increment of a step; ``StatePair`` is where it is summed.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
-from typing import Optional
+from typing import Optional, Sequence
 
 import numpy as np
 
 from .contract import LawResult, LawState
 
-__all__ = ["InterfaceState", "HistoryInterfaceState", "StatePair", "InterfaceHistory"]
+__all__ = ["InterfaceState", "HistoryInterfaceState", "StatePair", "InterfaceHistory",
+           "is_pointwise", "take_points"]
 
 
 @dataclass
@@ -253,7 +255,8 @@ class InterfaceHistory:
     def state(self) -> dict:
         """The committed history as one picklable dict (for checkpoints)."""
         return dict(committed=self.law.committed, dissipated=self.law.dissipated,
-                    normal_dissipated=self.law.normal_dissipated, multipliers=self.multipliers, multipliers_before=self.multipliers_before,
+                    normal_dissipated=self.law.normal_dissipated, multipliers=self.multipliers,
+                    multipliers_before=self.multipliers_before,
                     pairing=self.pairing)
 
     def restore(self, state: dict) -> None:
@@ -277,3 +280,34 @@ class InterfaceHistory:
         self.multipliers_before = None if before is None else np.array(before)
         self._multipliers_start = self._multipliers_trial = None
         self.pairing = state["pairing"]
+
+
+# ---------------------------------------------------------------------- per-point redistribution
+def is_pointwise(state: LawState) -> bool:
+    """Whether ``state`` can be cut and joined point by point: a dataclass (``InterfaceState``,
+    or a user law's) whose every field is an ndarray with one row per point (batch-first)."""
+    if not dataclasses.is_dataclass(state) or isinstance(state, type):
+        return False
+    n = len(state)
+    return all(isinstance(getattr(state, f.name), np.ndarray)
+               and np.ndim(getattr(state, f.name)) >= 1 and np.shape(getattr(state, f.name))[0] == n
+               for f in dataclasses.fields(state))
+
+
+def take_points(states: Sequence[LawState], index: np.ndarray) -> LawState:
+    """The points ``index`` of the states ``states`` joined in order (e.g. the states that
+    several ranks saved, re-dealt to another partition).
+
+    Raises:
+        TypeError: a state is not :func:`is_pointwise`, or the states are of different types.
+    """
+    first = states[0]
+    bad = [type(s).__name__ for s in states
+           if type(s) is not type(first) or not is_pointwise(s)]
+    if bad:
+        raise TypeError(f"law states of type {sorted(set(bad))} cannot be re-dealt point by point "
+                        "(a dataclass of batch-first ndarray fields, all of one type, is needed)")
+    index = np.asarray(index, dtype=np.int64)
+    joined = {f.name: np.concatenate([getattr(s, f.name) for s in states], axis=0)[index]
+              for f in dataclasses.fields(first)}
+    return dataclasses.replace(first, **joined)

@@ -29,6 +29,7 @@ that was written stays readable:
 from __future__ import annotations
 
 import csv
+import hashlib
 import io
 import os
 import warnings
@@ -177,6 +178,8 @@ class ResultWriter:
         self._u_out = None
         self._xdmf_started = False
         self._xdmf_steps = 0
+        self._mesh_name: Optional[str] = None    # None: the file's first mesh (see restore)
+        self._mesh_written = True
         if u is not None:
             msh = u.function_space.mesh
             degree = compat.geometry_degree(msh)
@@ -187,24 +190,52 @@ class ResultWriter:
                 self._u_out = fem.Function(compat.vector_space(msh, degree), name=u.name)
         self.csv_path = os.path.join(self.outdir, "history.csv")
         self.u_path = os.path.join(self.outdir, "displacement.xdmf")
+        self._layout_now = self._layout()
 
     # ------------------------------------------------------------------ displacement
     def _write_displacement(self, t: float) -> None:
         if self._u_out is not self.u:
             self._u_out.interpolate(self.u)
         mode = "a" if self._xdmf_started else "w"
+        msh = self.u.function_space.mesh
+        if not self._xdmf_started:
+            self._mesh_name, self._mesh_written = None, True
         with XDMFFile(self.comm, self.u_path, mode) as xdmf:
             if not self._xdmf_started:
-                xdmf.write_mesh(self.u.function_space.mesh)
-            xdmf.write_function(self._u_out, t)
+                xdmf.write_mesh(msh)
+            if self._mesh_name is None:
+                xdmf.write_function(self._u_out, t)
+            else:           # a resumed run on another partition: its own mesh grid (restore)
+                if not self._mesh_written:
+                    name, msh.name = msh.name, self._mesh_name
+                    try:
+                        xdmf.write_mesh(msh)
+                    finally:
+                        msh.name = name
+                    self._mesh_written = True
+                xdmf.write_function(self._u_out, t,
+                                    mesh_xpath=f"/Xdmf/Domain/Grid[@Name='{self._mesh_name}'][1]")
         self._xdmf_started = True
         self._xdmf_steps += 1
+
+    def _layout(self) -> str:
+        """Digest of the order in which the displacement file's mesh lists the geometry nodes
+        (collective): it depends on the partition, and a function's values follow it."""
+        if self.u is None:
+            return ""
+        mine = compat.geometry_input_indices(self.u.function_space.mesh)
+        every = self.comm.gather(mine, root=0)
+        digest = None
+        if self.comm.rank == 0:
+            digest = hashlib.sha256(np.concatenate(every).astype(np.int64).tobytes()).hexdigest()
+        return self.comm.bcast(digest, root=0)
 
     # ------------------------------------------------------------------ restart
     def checkpoint_state(self) -> dict:
         """What :meth:`restore` needs to continue these files (this rank's, picklable)."""
         return dict(rows=list(self.rows), load_factors=list(self.load_factors),
-                    xdmf_steps=self._xdmf_steps,
+                    xdmf_steps=self._xdmf_steps, layout=self._layout_now,
+                    mesh_name=self._mesh_name,
                     interface=None if self.interface_writer is None
                     else self.interface_writer.checkpoint_state())
 
@@ -221,6 +252,14 @@ class ResultWriter:
                 False
             self._xdmf_started = ok
             self._xdmf_steps = n if ok else 0
+            # the file's functions follow the node order of the mesh grid they point to; on
+            # another partition (or number of ranks) the next steps get a mesh grid of their own
+            self._mesh_name, self._mesh_written = state.get("mesh_name"), True
+            if ok and state.get("layout") != self._layout_now:
+                name = f"mesh_{self._layout_now[:12]}"
+                self._mesh_name = name
+                self._mesh_written = bool(run_on_root(self.comm, lambda: any(
+                    g.get("Name") == name for g in parse_xdmf(self.u_path).iter("Grid"))))
         if self.interface_writer is not None:
             self.interface_writer.restore(state["interface"])
 

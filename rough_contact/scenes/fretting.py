@@ -39,7 +39,7 @@ from rough_contact.solver.program import cycle_summary, preload_then_cyclic
 from rough_contact.solver.snes import SNESSolver
 from rough_contact.validation import check_scalar
 
-__all__ = ["FrettingRun", "run_amplitude", "run"]
+__all__ = ["FrettingRun", "PreloadStiffness", "run_amplitude", "run"]
 
 
 _SCENES: dict = {}   # meshes built by run_amplitude, per parameters and communicator
@@ -70,8 +70,8 @@ class FrettingRun:
         normal: the tabulated normal law (to reuse for other amplitudes).
         solved: increments solved by this call.
         k_normal, k_tangential: interface normal and tangential stiffness at the end of the
-            preload, int dp/dg dA and int dt_x/ds_x dA [N/mm] (nan when a restart skipped the
-            preload).
+            preload, int dp/dg dA and int dt_x/ds_x dA [N/mm] (a restart past the preload
+            reports the checkpointed run's values; NaN only when the preload was not reached).
     """
 
     amplitude_um: float
@@ -92,6 +92,25 @@ class FrettingRun:
     k_tangential: float
 
 
+class PreloadStiffness:
+    """The interface stiffness at the end of the preload, kept with the checkpoints (a
+    :class:`~rough_contact.solver.checkpoint.ResumableOutput`): a run restarted past the
+    preload reports the value the checkpointed run measured.
+
+    Attributes:
+        value: (3,) int dp/dg dA, int dt_x/ds_x dA, int dt_y/ds_y dA [N/mm]; NaN until measured.
+    """
+
+    def __init__(self):
+        self.value = np.full(3, np.nan)
+
+    def checkpoint_state(self) -> np.ndarray:
+        return self.value.copy()
+
+    def restore(self, state) -> None:
+        self.value = np.array(state, dtype=float).reshape(3)
+
+
 def run_amplitude(amplitude_um: float, *, size=2.0, height=1.0, mesh_size=0.5, order=1,
                   pressure=10.0, cycles=2, steps_per_cycle=16, preload_steps=2, normal=None,
                   comm=MPI.COMM_WORLD, verbose=False, loop_csv=None, checkpoint=None,
@@ -105,7 +124,8 @@ def run_amplitude(amplitude_um: float, *, size=2.0, height=1.0, mesh_size=0.5, o
     continue); ``stop_after``: stop after this many increments (the result then covers them
     only). ``solved`` in the result: the increments solved by this call; ``k_normal``,
     ``k_tangential``: the interface's normal and tangential stiffness at the end of the preload
-    (int dp/dg dA, int dt_x/ds_x dA [N/mm]; NaN when a restart skipped the preload).
+    (int dp/dg dA, int dt_x/ds_x dA [N/mm]; kept with the checkpoints, so a restart past the
+    preload reports the measured values; NaN only when the run stopped before the preload's end).
     """
     a = check_scalar("amplitude", amplitude_um, lo=0.0, unit="um") * 1e-3
     check_scalar("pressure", pressure, lo=0.0, unit="MPa")
@@ -126,22 +146,23 @@ def run_amplitude(amplitude_um: float, *, size=2.0, height=1.0, mesh_size=0.5, o
     solver = SNESSolver(problem, prefix="fret_")
     rec = CsvRecorder(loop_csv, LOOP_COLUMNS, comm)
     solved = 0
-    k_interface = np.full(3, np.nan)          # stays NaN when restarted past the preload
+    k_interface = PreloadStiffness()          # restored with the checkpoint on a restart
     for inc in load_path(problem, solver, prog.times, verbose=verbose, checkpoint=checkpoint,
-                         resume=restart, outputs=[rec], max_steps=stop_after):
+                         resume=restart, outputs=[rec, k_interface], max_steps=stop_after):
         rec.add((inc.load_factor, problem.scales["cyclic"] * a, problem.reaction(top)[0],
                  inc.contact_force[2], inc.dissipation, inc.n_slipping, inc.n_points,
                  inc.newton_total))
         solved += 1
         if abs(inc.load_factor - 1.0) < 1e-12:         # end of the preload
-            k_interface = ci.interface_stiffness()
+            k_interface.value = ci.interface_stiffness()
     solver.destroy()
     t, u, fx, fz, d, slip, npts, its = rec.array().T
     return FrettingRun(amplitude_um=amplitude_um, force=force, dofs=problem.num_dofs, t=t, u=u,
                        fx=fx, fz=fz, dissipation=d, slipping=slip.astype(int),
                        n_points=npts.astype(int), newton=int(its.sum()),
                        cycles=cycle_summary(t, prog, u, fx, d), normal=normal, solved=solved,
-                       k_normal=float(k_interface[0]), k_tangential=float(k_interface[1]))
+                       k_normal=float(k_interface.value[0]),
+                       k_tangential=float(k_interface.value[1]))
 
 
 def run(amplitudes_um=(0.3, 0.5, 0.7, 1.0, 2.0, 4.0), outdir="results/fretting", plot=True,

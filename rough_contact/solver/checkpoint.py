@@ -6,27 +6,42 @@ interface's committed law state and accumulated dissipation, the load factor, th
 the list of load factors (index, current increment size, cutbacks) and the secant predictor's
 previous state (the displacement, and for an augmented-Lagrangian law the multipliers the
 last increment started from). ``load_path(..., resume=DIR)`` restores it into a freshly built
-problem (same mesh, same number of ranks, same law) and continues; the resumed run reproduces
-the uninterrupted one to round-off (tests/fem/test_checkpoint.py).
+problem and continues; the resumed run reproduces the uninterrupted one to round-off
+(tests/fem/test_checkpoint.py).
+
+The state is stored by keys that do not depend on the partition: every displacement node by
+its index in the arrays the mesh was built from (``ContactProblem.owned_node_keys``), every
+interface point by its coordinates. A restart finds its own nodes and points among those all
+ranks saved, so it may run on another partition of the same mesh or on another number of ranks
+(tests/demos/test_multiprocess.py: written on 2 ranks, resumed on 1, and the reverse). Where no
+such keys exist (a displacement space of another degree than the geometry, a sliding pairing,
+a law state that is not a dataclass of per-point arrays) the checkpoint is bound to its
+partition: each rank must hold the DOFs, in the same local order, that some rank held (the same
+parts in another rank order are accepted), on the same number of ranks.
 
 Output writers given as ``load_path(..., outputs=[...])`` (:class:`ResumableOutput`, e.g.
 ``ResultWriter``) are part of the checkpoint: the checkpoint of increment k is written when the
 caller's loop asks for increment k + 1, i.e. after the loop body has written k's output, and
 holds each writer's state; on resume every writer is restored to it, so the resumed run
-continues the same files (``rough_contact.solver.output``).
+continues the same files (``rough_contact.solver.output``). Rank r of the resumed run restores
+the state rank r saved (rank 0's if the checkpoint has fewer ranks).
+
+What the checkpoint belongs to is recorded in ``meta.json``: the mesh (DOF count, a checksum of
+the DOF coordinates, the number of interface points) and a fingerprint of the problem
+(``ContactProblem.describe``, ``rough_contact.fingerprint``): the interface law's parameters,
+the pairing, the quadrature rule, the enforcement, the load program (each channel's scale at
+every load factor), the loads and the materials; floats as written (``repr``), arrays by a hash.
 
 Atomicity: two slots ``slot0/`` and ``slot1/`` are written alternately (one ``rank<r>.pkl`` per
 rank, then ``meta.json``); the file ``LATEST`` naming the complete slot is replaced atomically
 (``os.replace``) only after every rank has written and flushed its file. A run killed at any
 moment leaves ``LATEST`` pointing at a complete slot.
 
-Refused with a clear error: a directory without a checkpoint, a different number of ranks,
-another mesh (DOF count or a checksum of the DOF coordinates differ), another partition (no rank
-held this rank's DOFs, in this local order, when the checkpoint was written: DOLFINx's
-partitioner can give another partition for a second build of the same mesh in one process; the
-same parts handed to the ranks in another order, as DOLFINx 0.9 does between processes, are
-accepted: each rank reads the file of the rank that held its part), another law
-(type or number of interface points), or a load-factor list that does not match the saved one.
+Refused with a clear error naming what differs: a directory without a checkpoint, a checkpoint
+of an earlier format, another mesh, another law, pairing, quadrature, enforcement, load program,
+loads or materials (each differing parameter named with both values), a load-factor list that
+does not match the saved one, and, for a checkpoint bound to its partition, another partition
+or number of ranks.
 """
 
 from __future__ import annotations
@@ -40,8 +55,18 @@ from typing import Optional, Protocol, Sequence, runtime_checkable
 import numpy as np
 from mpi4py import MPI
 
-__all__ = ["ResumableOutput", "CheckpointState", "has_checkpoint", "CheckpointError", "signature", "write_checkpoint",
-           "read_checkpoint"]
+from rough_contact.fingerprint import differences
+from rough_contact.interface.state import is_pointwise, take_points
+
+__all__ = ["ResumableOutput", "CheckpointState", "has_checkpoint", "CheckpointError", "signature",
+           "write_checkpoint", "read_checkpoint", "FORMAT"]
+
+FORMAT = 2     # 2: state by partition-independent keys, the problem's fingerprint
+
+# the fingerprint's parts, as an error message names them
+_PARTS = (("interface.law", "interface law"), ("interface.pairing", "pairing"),
+          ("interface.quadrature", "quadrature"), ("interface.enforcement", "enforcement"),
+          ("program", "load program"), ("loads", "loads"), ("materials", "materials"))
 
 
 class CheckpointError(ValueError):
@@ -73,16 +98,26 @@ class CheckpointState:
     factors: list
 
 
-def signature(problem) -> dict:
-    """What identifies the problem a checkpoint belongs to (collective)."""
+def signature(problem, factors: Sequence[float]) -> dict:
+    """What identifies the problem a checkpoint belongs to (collective): the mesh (DOF count,
+    DOF coordinate checksum, interface points) and the problem's fingerprint
+    (``problem.describe(factors)``)."""
     x = problem.owned_dof_coordinates()
     local = float(np.round(x, 9).sum() + 7.0 * np.round(x ** 2, 9).sum())
     ci = problem.interface
     return dict(
         ranks=problem.comm.size, num_dofs=int(problem.num_dofs),
         dof_checksum=float(problem.comm.allreduce(local, op=MPI.SUM)),
-        law=None if ci is None else type(ci.law).__name__,
-        n_points=0 if ci is None else int(ci.n_points_global))
+        n_points=0 if ci is None else int(ci.n_points_global),
+        fingerprint=problem.describe([float(f) for f in factors]))
+
+
+def _keyed(problem) -> bool:
+    """Whether this problem's state can be stored by partition-independent keys (collective)."""
+    ci = problem.interface
+    ok = problem.owned_node_keys() is not None and (
+        ci is None or (ci.history.pairing is None and is_pointwise(ci.history.law.committed)))
+    return bool(problem.comm.allreduce(ok, op=MPI.LAND))
 
 
 def write_checkpoint(directory: str, problem, state: CheckpointState, sig: dict,
@@ -103,10 +138,15 @@ def write_checkpoint(directory: str, problem, state: CheckpointState, sig: dict,
             os.remove(os.path.join(path, name))
     comm.Barrier()
     ci = problem.interface
+    keyed = _keyed(problem)
     data = dict(u=problem.local_solution_values().copy(), u_previous=state.u_previous,
                 partition=_local_checksum(problem),
                 interface=None if ci is None else ci.state(),
                 outputs=[o.checkpoint_state() for o in outputs])
+    if keyed:    # owned nodes by key (u_previous is the owned part already), points by position
+        data.update(keys=problem.owned_node_keys(), x=problem.owned_dof_coordinates().copy(),
+                    u_owned=problem.owned_solution_values().copy(),
+                    points=None if ci is None else ci.point_coordinates().copy())
     with open(os.path.join(path, f"rank{comm.rank}.pkl"), "wb") as f:
         pickle.dump(data, f, protocol=pickle.HIGHEST_PROTOCOL)
         f.flush()
@@ -114,8 +154,9 @@ def write_checkpoint(directory: str, problem, state: CheckpointState, sig: dict,
     partitions = comm.gather(data["partition"].tolist(), root=0)
     comm.Barrier()
     if comm.rank == 0:
-        meta = dict(signature=sig, partitions=partitions, step=state.step, index=state.index,
-                    delta=state.delta, cutbacks=state.cutbacks, load_factor=state.load_factor,
+        meta = dict(format=FORMAT, signature=sig, keyed=keyed, partitions=partitions,
+                    step=state.step, index=state.index, delta=state.delta,
+                    cutbacks=state.cutbacks, load_factor=state.load_factor,
                     lam_previous=state.lam_previous, factors=list(map(float, state.factors)))
         with open(os.path.join(path, "meta.json"), "w") as f:
             json.dump(meta, f)
@@ -169,6 +210,23 @@ def _latest(directory: str) -> Optional[str]:
         return None
 
 
+def _check_fingerprint(directory: str, saved: dict, mine: dict) -> None:
+    """Refuse another law, pairing, quadrature, enforcement, program, loads or materials,
+    naming every differing parameter (identical on every rank: no collective needed)."""
+    found = []
+    for key, label in _PARTS:
+        a, b = saved, mine
+        for part in key.split("."):
+            a = a.get(part) if isinstance(a, dict) else None
+            b = b.get(part) if isinstance(b, dict) else None
+        diff = differences(a, b)
+        if diff:
+            found.append(f"{label} differs: {'; '.join(diff)}")
+    if found:
+        raise CheckpointError(f"restart directory {directory!r} was written by another problem "
+                              f"setup; refused, because " + " | ".join(found))
+
+
 def read_checkpoint(directory: str, problem, factors,
                     outputs: Sequence[ResumableOutput] = ()) -> CheckpointState:
     """Restore the latest checkpoint of ``directory`` into ``problem`` (collective): the
@@ -190,25 +248,131 @@ def read_checkpoint(directory: str, problem, factors,
         with open(os.path.join(path, "meta.json")) as f:
             meta = json.load(f)
     meta = comm.bcast(meta, root=0)
-    mine = signature(problem)
+    if meta.get("format") != FORMAT:
+        raise CheckpointError(f"restart directory {directory!r} holds a checkpoint of format "
+                              f"{meta.get('format', 1)!r}; this version reads format {FORMAT} "
+                              "only (it records the problem's fingerprint): rerun from the start")
+    factors = [float(f) for f in factors]
+    mine = signature(problem, factors)
     saved = meta["signature"]
-    diff = [f"{k}: checkpoint {saved[k]!r}, this problem {mine[k]!r}" for k in saved
-            if (saved[k] != mine[k] if k != "dof_checksum"
-                else not np.isclose(saved[k], mine[k], rtol=1e-12, atol=1e-9))]
+    diff = [f"{k}: checkpoint {saved[k]!r}, this problem {mine[k]!r}"
+            for k in ("num_dofs", "n_points") if saved[k] != mine[k]]
+    if not np.isclose(saved["dof_checksum"], mine["dof_checksum"], rtol=1e-12, atol=1e-9):
+        diff.append(f"dof_checksum: checkpoint {saved['dof_checksum']!r}, this problem "
+                    f"{mine['dof_checksum']!r}")
     if diff:
         raise CheckpointError(f"restart directory {directory!r} was written by another problem "
-                              f"(mesh, partition or law differ): {'; '.join(diff)}")
-    factors = [float(f) for f in factors]
+                              f"(another mesh): {'; '.join(diff)}")
     if factors != meta["factors"]:
         raise CheckpointError(f"the load factors given ({len(factors)}) differ from those of the "
                               f"checkpointed run ({len(meta['factors'])}): resume with the same "
                               "load path")
+    _check_fingerprint(directory, saved["fingerprint"], mine["fingerprint"])
+    n_saved = int(saved["ranks"])
+    if meta["keyed"] and _keyed(problem):
+        files = []
+        for r in range(n_saved):
+            with open(os.path.join(path, f"rank{r}.pkl"), "rb") as f:
+                files.append(pickle.load(f))
+        own = files[comm.rank if comm.rank < n_saved else 0]
+        u_previous = _restore_by_keys(directory, problem, files)
+    else:
+        own, u_previous = _restore_same_partition(directory, problem, path, meta, n_saved)
+    saved_outputs = own.get("outputs", [])
+    if len(saved_outputs) != len(outputs):
+        raise CheckpointError(f"the checkpoint in {directory!r} holds the state of "
+                              f"{len(saved_outputs)} output writer(s), {len(outputs)} were given: "
+                              "resume with the same outputs")
+    problem.set_load_factor(meta["load_factor"])
+    for writer, state in zip(outputs, saved_outputs):
+        writer.restore(state)
+    return CheckpointState(step=meta["step"], index=meta["index"], delta=meta["delta"],
+                           cutbacks=meta["cutbacks"], load_factor=meta["load_factor"],
+                           lam_previous=meta["lam_previous"], u_previous=u_previous,
+                           factors=factors)
+
+
+def _restore_by_keys(directory: str, problem, files: list) -> Optional[np.ndarray]:
+    """Take this rank's nodes and points out of every saved rank's data (collective); returns
+    the owned part of the secant predictor's previous displacement (or None)."""
+    comm, ci = problem.comm, problem.interface
+    keys = np.concatenate([d["keys"] for d in files])
+    order = np.argsort(keys, kind="stable")
+    sorted_keys = keys[order]
+    mine = problem.owned_node_keys()
+    if len(keys):
+        pos = np.minimum(np.searchsorted(sorted_keys, mine), len(keys) - 1)
+        found, idx = sorted_keys[pos] == mine, order[pos]
+    else:
+        found, idx = np.zeros(len(mine), dtype=bool), np.zeros(len(mine), dtype=np.int64)
+    x = np.concatenate([d["x"] for d in files])
+    scale = max(1.0, float(np.abs(x).max(initial=0.0)))
+    same = bool(np.all(found)) and np.allclose(x[idx], problem.owned_dof_coordinates(),
+                                               rtol=0.0, atol=1e-9 * scale)
+    bs = next((d["u_owned"].size // len(d["keys"]) for d in files if len(d["keys"])), 1)
+    if ci is not None:
+        points = np.concatenate([d["points"] for d in files])
+        j, ok_points = _match_points(points, ci.point_coordinates())
+        same = same and ok_points
+    if not comm.allreduce(bool(same), op=MPI.LAND):
+        raise CheckpointError(
+            f"restart directory {directory!r}: the saved nodes or interface points do not cover "
+            "this problem's (another mesh built from other input arrays?); rank(s) "
+            f"{[r for r, s in enumerate(comm.allgather(bool(same))) if not s]} miss some")
+    u = np.concatenate([d["u_owned"].reshape(-1, bs) for d in files])
+    problem.owned_solution_values()[:] = u[idx].reshape(-1)
+    problem.scatter_solution()
+    u_previous = None
+    if files[0]["u_previous"] is not None:
+        up = np.concatenate([np.asarray(d["u_previous"]).reshape(-1, bs) for d in files])
+        u_previous = up[idx].reshape(-1).copy()
+    if ci is not None:
+        states = [d["interface"] for d in files]
+
+        def joined(name):
+            parts = [s.get(name) for s in states]
+            return None if parts[0] is None else np.concatenate(parts, axis=0)[j]
+
+        restored = dict(committed=take_points([s["committed"] for s in states], j),
+                        dissipated=joined("dissipated"),
+                        normal_dissipated=joined("normal_dissipated"),
+                        multipliers=joined("multipliers"),
+                        multipliers_before=joined("multipliers_before"), pairing=None)
+        if ci.restore(restored):
+            problem.rebuild_matrices()
+    return u_previous
+
+
+def _match_points(saved: np.ndarray, mine: np.ndarray):
+    """For each of ``mine`` (m, 3), the index of the saved point at its position (within 1e-9
+    of the extent); (indices, all matched one to one)."""
+    from scipy.spatial import cKDTree
+
+    if len(mine) == 0:
+        return np.zeros(0, dtype=np.int64), True
+    if len(saved) == 0:
+        return np.zeros(len(mine), dtype=np.int64), False
+    extent = max(1.0, float(np.ptp(saved, axis=0).max()))
+    dist, j = cKDTree(saved).query(mine, k=1)
+    ok = bool(np.all(dist <= 1e-9 * extent)) and len(np.unique(j)) == len(j)
+    return np.asarray(j, dtype=np.int64), ok
+
+
+def _restore_same_partition(directory: str, problem, path: str, meta: dict, n_saved: int):
+    """The partition-bound restore: every rank must hold a part some rank held (collective).
+    Returns (this rank's own saved data, u_previous)."""
+    comm = problem.comm
+    if n_saved != comm.size:
+        raise CheckpointError(
+            f"restart directory {directory!r} was written on {n_saved} rank(s), this run has "
+            f"{comm.size}: its state is bound to its partition (no partition-independent keys: "
+            "a space of another degree than the geometry, a sliding pairing or a law state that "
+            "is not a dataclass of per-point arrays); resume on the same number of ranks")
     with open(os.path.join(path, f"rank{comm.rank}.pkl"), "rb") as f:
         own = pickle.load(f)
     # the same partition: every rank must hold the DOFs (in the same local order) that some rank
-    # held when the checkpoint was written. DOLFINx 0.9 may hand the same parts to the ranks in
-    # another order in a fresh process: a rank then takes the data of the rank that held its
-    # part (the output writers' state stays with the rank); a different partition is refused.
+    # held when the checkpoint was written; the same parts in another rank order are accepted
+    # (a rank then takes the data of the rank that held its part).
     source = _partition_source(comm, meta.get("partitions"), _local_checksum(problem))
     data = own
     if source is not None and source != comm.rank:
@@ -219,23 +383,11 @@ def read_checkpoint(directory: str, problem, factors,
         bad = comm.allgather(None if same else comm.rank)
         raise CheckpointError(
             f"restart directory {directory!r}: the mesh is partitioned differently from the "
-            f"checkpointed run (rank(s) {[r for r in bad if r is not None]} hold other DOFs); "
-            "build the mesh the same way on the same number of ranks (a fresh process building "
-            "the same scenes in the same order does)")
-    saved_outputs = own.get("outputs", [])
-    if len(saved_outputs) != len(outputs):
-        raise CheckpointError(f"the checkpoint in {directory!r} holds the state of "
-                              f"{len(saved_outputs)} output writer(s), {len(outputs)} were given: "
-                              "resume with the same outputs")
+            f"checkpointed run (rank(s) {[r for r in bad if r is not None]} hold other DOFs) and "
+            "the checkpoint is bound to its partition (see rough_contact.solver.checkpoint)")
     problem.local_solution_values()[:] = data["u"]
     problem.scatter_solution()
-    problem.set_load_factor(meta["load_factor"])
     ci = problem.interface
     if ci is not None and ci.restore(data["interface"]):   # a sliding pairing's partners
         problem.rebuild_matrices()
-    for writer, saved in zip(outputs, saved_outputs):
-        writer.restore(saved)
-    return CheckpointState(step=meta["step"], index=meta["index"], delta=meta["delta"],
-                           cutbacks=meta["cutbacks"], load_factor=meta["load_factor"],
-                           lam_previous=meta["lam_previous"], u_previous=data["u_previous"],
-                           factors=factors)
+    return own, data["u_previous"]

@@ -323,7 +323,7 @@ class _Stepper:
         restored = None
         if resume is not None:
             restored = read_checkpoint(resume, problem, self.factors, outputs)
-        sig = None if checkpoint is None else checkpoint_signature(problem)
+        sig = None if checkpoint is None else checkpoint_signature(problem, self.factors)
         _check_initial_guess(problem)
         self.u_committed = problem.solution_vector().copy()
         self.lam_committed = problem.load_factor

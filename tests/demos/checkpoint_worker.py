@@ -3,7 +3,8 @@ preload + cyclic rough-law program, uninterrupted ("full"), writing checkpoints 
 printing each converged step and this rank's PID), or resumed from a directory ("resume").
 Every mode writes its results (ResultWriter) into OUT.json's name without the suffix + "_out";
 "checkpointed" and "resume" share DIR + "_out". Writes the final figures as JSON (rank 0).
-Usage: checkpoint_worker.py MODE DIR OUT.json"""
+A fourth argument N makes a "checkpointed" run stop after N increments (its checkpoint written).
+Usage: checkpoint_worker.py MODE DIR OUT.json [N]"""
 
 import json
 import os
@@ -28,11 +29,13 @@ def model():
     return test_checkpoint._model()
 
 
-def main(mode, directory, out):
+def main(mode, directory, out, stop_after=None):
     comm = MPI.COMM_WORLD
     problem, solver = model()
     kwargs = {"checkpoint": directory} if mode == "checkpointed" else \
         {"resume": directory} if mode == "resume" else {}
+    if stop_after is not None:
+        kwargs["max_steps"] = int(stop_after)
     pids = comm.gather(os.getpid(), root=0)
     if mode == "checkpointed" and comm.rank == 0:
         print("PIDS " + " ".join(str(p) for p in pids), flush=True)
@@ -59,4 +62,4 @@ def main(mode, directory, out):
 
 
 if __name__ == "__main__":
-    main(*sys.argv[1:4])
+    main(*sys.argv[1:5])

@@ -15,10 +15,11 @@ from pathlib import Path
 WORKER = Path(__file__).with_name("checkpoint_worker.py")
 
 
-def worker_cmd(mode, directory, out) -> list:
-    """``mpirun -n 2`` of the worker in ``mode`` ("full", "checkpointed", "resume")."""
-    return [shutil.which("mpirun"), "-n", "2", sys.executable, str(WORKER), mode,
-            str(directory), str(out)]
+def worker_cmd(mode, directory, out, ranks: int = 2, stop_after=None) -> list:
+    """``mpirun -n ranks`` of the worker in ``mode`` ("full", "checkpointed", "resume");
+    ``stop_after``: a checkpointed run stops after that many increments."""
+    return [shutil.which("mpirun"), "-n", str(ranks), sys.executable, str(WORKER), mode,
+            str(directory), str(out)] + ([] if stop_after is None else [str(stop_after)])
 
 
 def kill_checkpointed_run(directory, out, env, kill_after: int, timeout: float = 600):

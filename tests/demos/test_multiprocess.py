@@ -13,7 +13,15 @@ uninterrupted run's to 1e-12 relative, and its output files (history.csv, displa
 interface.xdmf, written by the killed run and continued by the resumed one) hold every increment
 once with the uninterrupted run's values.
 
-(2) The non-matching pairings' rank-independence test on 3 ranks (issue 9: 1 = 2 = 3 ranks).
+(2) A checkpoint written on 2 ranks resumed on 1, and the reverse (issue 24: restart does not
+depend on the partition): the same program stopped after increment 9 (the first tangential
+cycle, slipping) and resumed on the other number of ranks ends with the uninterrupted run's
+dissipation, contact force and displacement norms on the resuming number of ranks to 1e-10
+relative; its history.csv and interface.xdmf equal that run's, and displacement.xdmf holds every
+increment once with the same values at every point (read through the mesh grid each step
+points to: the node order of an XDMF mesh may follow the partition).
+
+(3) The non-matching pairings' rank-independence test on 3 ranks (issue 9: 1 = 2 = 3 ranks).
 
 Runs the workers with mpirun; skipped without it.
 """
@@ -36,8 +44,9 @@ ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIR
            OPENBLAS_NUM_THREADS="1")
 
 
-def _run(mode, directory, out, timeout=600):
-    proc = subprocess.run(worker_cmd(mode, directory, out), env=ENV, capture_output=True, text=True, timeout=timeout)
+def _run(mode, directory, out, timeout=600, ranks=2, stop_after=None):
+    proc = subprocess.run(worker_cmd(mode, directory, out, ranks, stop_after), env=ENV,
+                          capture_output=True, text=True, timeout=timeout)
     assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
     return json.loads(Path(out).read_text())
 
@@ -84,6 +93,81 @@ def test_sigkill_then_resume(tmp_path):
             assert resumed[key] == pytest.approx(reference[key], rel=1e-12), key
         np.testing.assert_allclose(resumed["F"], reference["F"], rtol=1e-12,
                                    atol=1e-12 * np.abs(reference["F"]).max())
+
+
+def _displacement_by_point(path: Path, time: float) -> dict:
+    """{rounded node coordinates: (sum of the values, sum of their squares)} of the step at
+    ``time`` of a DOLFINx displacement.xdmf, read through the mesh grid the step points to (a
+    partition-free view: coincident nodes of two bodies are summed)."""
+    import xml.etree.ElementTree as ET
+
+    import h5py
+
+    xi = "{http://www.w3.org/2001/XInclude}include"
+    root = ET.parse(path).getroot()
+    domain = root.find("Domain")
+    step = next(g for g in root.iter("Grid") if g.find("Time") is not None
+                and float(g.find("Time").get("Value")) == time)
+    pointer = step.find(xi).get("xpointer")
+    name = pointer.split("@Name='")[1].split("'")[0] if "@Name=" in pointer else None
+    mesh = next(g for g in domain.findall("Grid") if g.get("GridType") == "Uniform"
+                and (name is None or g.get("Name") == name))
+
+    def read(item):
+        file, _, dataset = item.text.strip().partition(":")
+        with h5py.File(path.parent / file, "r") as f:
+            return f[dataset][...]
+
+    x = read(mesh.find("Geometry/DataItem"))
+    u = read(step.find("Attribute/DataItem"))
+    out = {}
+    for xk, uk in zip(np.round(x, 9), u):
+        key = tuple(xk.tolist())
+        s, q = out.get(key, (0.0, 0.0))
+        out[key] = (s + uk, q + uk * uk)
+    return name, out
+
+
+@pytest.mark.skipif(MPIRUN is None, reason="needs mpirun")
+@pytest.mark.parametrize("written, resumed", [(2, 1), (1, 2)])
+def test_resume_on_another_number_of_ranks(tmp_path, written, resumed):
+    reference = _run("full", tmp_path / "unused", tmp_path / "full.json", ranks=resumed)
+    directory = tmp_path / "ckpt"
+    stopped = _run("checkpointed", directory, tmp_path / "stopped.json", ranks=written,
+                   stop_after=9)
+    assert stopped["step"] == 9 and stopped["D"] > 0.0         # slipping: history matters
+    got = _run("resume", directory, tmp_path / "resumed.json", ranks=resumed)
+    assert got["first"] == 10 and got["step"] == reference["step"]
+    for key in ("D", "unorm", "umax"):
+        assert got[key] == pytest.approx(reference[key], rel=1e-10), key
+    np.testing.assert_allclose(got["F"], reference["F"], rtol=1e-10,
+                               atol=1e-10 * np.abs(reference["F"]).max())
+    sys.path.insert(0, str(Path(__file__).parents[1] / "fem"))
+    from test_checkpoint import _csv, _xdmf_steps
+
+    from rough_contact.io import read_interface_results
+
+    run, ref = Path(f"{directory}_out"), tmp_path / "full_out"
+    rows, want = _csv(run / "history.csv"), _csv(ref / "history.csv")
+    assert [r["step"] for r in rows] == list(range(1, reference["step"] + 1))
+    for g, w in zip(rows, want):
+        for key in ("load_factor", "dissipation_Nmm", "contact_fz_N", "contact_fx_N"):
+            assert g[key] == pytest.approx(w[key], rel=1e-9, abs=1e-12), key
+    a, b = (read_interface_results(str(d / "interface.xdmf")) for d in (run, ref))
+    np.testing.assert_array_equal(a.times, b.times)
+    scale = np.abs(b.field("dissipation_N_per_mm")).max()
+    np.testing.assert_allclose(a.field("dissipation_N_per_mm"), b.field("dissipation_N_per_mm"),
+                               rtol=1e-9, atol=1e-10 * scale)
+    times, _ = _xdmf_steps(run / "displacement.xdmf")
+    assert times == _xdmf_steps(ref / "displacement.xdmf")[0] and len(times) == reference["step"]
+    umax = reference["umax"]
+    for t in (times[0], times[-1]):          # written by the stopped run / by the resumed one
+        _, mine = _displacement_by_point(run / "displacement.xdmf", t)
+        _, theirs = _displacement_by_point(ref / "displacement.xdmf", t)
+        assert mine.keys() == theirs.keys()
+        for key, (s, q) in theirs.items():
+            np.testing.assert_allclose(mine[key][0], s, rtol=0, atol=1e-10 * umax)
+            np.testing.assert_allclose(mine[key][1], q, rtol=0, atol=1e-10 * umax ** 2)
 
 
 @pytest.mark.skipif(MPIRUN is None, reason="needs mpirun")

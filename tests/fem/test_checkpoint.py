@@ -39,7 +39,7 @@ _NORMAL = {}
 _SCENES = {}
 
 
-def _model(mesh_size=0.5):
+def _model(mesh_size=0.5, case="b", program=None):
     comm = MPI.COMM_WORLD
     # built once per size: a second build of a mesh may be partitioned differently on 2 ranks,
     # and a checkpoint resumes only into the partition it was written from
@@ -50,7 +50,7 @@ def _model(mesh_size=0.5):
     V = compat.vector_space(scene.mesh, 1)
     clamp = fem.dirichletbc(np.zeros(3, dtype=PETSc.ScalarType), fem.locate_dofs_topological(
         V, 2, scene.facet_tags.find(scene.tag("bottom"))), V)
-    law, normal = flat_punch.make_law(comm, case="b", normal_law="elastic", seating_pressure=5.0,
+    law, normal = flat_punch.make_law(comm, case=case, normal_law="elastic", seating_pressure=5.0,
                                       normal=_NORMAL.get("n"))
     _NORMAL["n"] = normal
     first, second = scene.contact_pair
@@ -62,7 +62,7 @@ def _model(mesh_size=0.5):
         facet_tags=scene.facet_tags, interface=ci, seating_tag=first,
         seating_stiffness=SEATING_STIFFNESS,
         prescribed=[PrescribedDisplacement(top, (2e-3, 0.0, 0.0), (0,), channel="cyclic")],
-        programs=PROGRAM.channels)
+        programs=(program or PROGRAM).channels)
     return problem, SNESSolver(problem, prefix="ck_")
 
 
@@ -184,12 +184,15 @@ def test_resume_refuses_another_problem(tmp_path):
 
 
 def test_resume_refuses_another_partition(tmp_path, monkeypatch):
-    """A rank holding other DOFs than when the checkpoint was written (another partition of the
-    same mesh: the global checksum cannot see it) is refused, naming the rank. Simulated by
-    shifting the last rank's local checksum."""
+    """A checkpoint bound to its partition (no partition-independent node keys: simulated by
+    a problem without them) refuses a rank holding other DOFs than when it was written (the
+    global checksum cannot see it), naming the rank. Simulated by shifting the last rank's
+    local checksum."""
+    from rough_contact.fem.problem import ContactProblem
     from rough_contact.solver import checkpoint as ck
 
     comm = MPI.COMM_WORLD
+    monkeypatch.setattr(ContactProblem, "owned_node_keys", lambda self: None)
     directory = comm.bcast(str(tmp_path / "ckpt"), root=0)
     problem, solver = _model()
     for inc in load_path(problem, solver, PROGRAM.times[:2], verbose=False,
@@ -208,3 +211,86 @@ def test_resume_refuses_another_partition(tmp_path, monkeypatch):
                        rf"\[{comm.size - 1}\]"):
         next(load_path(problem, solver, PROGRAM.times[:2], resume=directory))
     solver.destroy()
+
+
+def test_resume_refuses_another_law_or_program_naming_what_differs(tmp_path):
+    """Issue 24: a checkpoint of friction case (b) resumed with case (a) (another friction law of
+    the same class) was accepted and appended to the old history. Refused now, naming the
+    parameter and both values as written (Fig 18: case b mu_macro 0.5, mu_o ratio 0.5; case a
+    0.2 and 1.0). A load program with another cyclic amplitude (same pseudo-times) is refused
+    too, naming the channel and the first pseudo-time where the scales differ (1.125: a quarter
+    of the way up the first cycle's ramp, a/2 = 0.5 vs 0.25)."""
+    directory = MPI.COMM_WORLD.bcast(str(tmp_path / "ckpt"), root=0)
+    problem, solver = _model()
+    for inc in load_path(problem, solver, PROGRAM.times[:3], verbose=False,
+                         checkpoint=directory):
+        pass
+    solver.destroy()
+    other, solver = _model(case="a")
+    with pytest.raises(CheckpointError) as err:
+        next(load_path(other, solver, PROGRAM.times[:3], resume=directory))
+    msg = str(err.value)
+    assert "interface law differs" in msg
+    assert "friction.mu_macro[0]: 0.5 in the checkpoint, 0.2 now" in msg
+    assert "friction.mu_initial_ratio[1]: 0.5 in the checkpoint, 1.0 now" in msg
+    assert "pairing differs" not in msg and "load program" not in msg
+    solver.destroy()
+    half = preload_then_cyclic(preload_steps=2, cycles=1, steps_per_cycle=8, amplitude=0.5)
+    assert half.times[:3] == PROGRAM.times[:3]
+    other, solver = _model(program=half)
+    with pytest.raises(CheckpointError, match=r"load program differs: cyclic\.t=1\.125: 0\.5 "
+                       r"in the checkpoint, 0\.25 now"):
+        next(load_path(other, solver, PROGRAM.times[:3], resume=directory))
+    solver.destroy()
+    problem, solver = _model()                  # the same problem resumes
+    assert [inc.step for inc in load_path(problem, solver, PROGRAM.times[:3], verbose=False,
+                                          resume=directory)] == []
+    solver.destroy()
+
+
+def test_resumed_displacement_output_on_another_node_layout(tmp_path, monkeypatch):
+    """A resumed run whose mesh lists its nodes in another order (another partition: simulated
+    by giving the resumed writer another layout digest) writes its steps against a mesh grid of
+    its own in displacement.xdmf, so every step reads back with the values of the uninterrupted
+    run (same mesh here, so the arrays compare directly); a second resume on that layout reuses
+    the grid."""
+    from rough_contact.io import results
+
+    comm = MPI.COMM_WORLD
+    directory = comm.bcast(str(tmp_path / "ckpt"), root=0)
+    out_ref, out_run = comm.bcast((str(tmp_path / "ref"), str(tmp_path / "run")), root=0)
+    times = PROGRAM.times[:6]
+    problem, solver = _model()
+    writer = ResultWriter(out_ref, comm, u=problem.u)
+    for inc in load_path(problem, solver, times, verbose=False):
+        writer.write(inc)
+    solver.destroy()
+    problem, solver = _model()
+    writer = ResultWriter(out_run, comm, u=problem.u)
+    for inc in load_path(problem, solver, times, verbose=False, checkpoint=directory,
+                         outputs=[writer], max_steps=3):
+        writer.write(inc)
+    solver.destroy()
+    monkeypatch.setattr(results.ResultWriter, "_layout", lambda self: "f" * 64)
+    for stop in (4, None):                # resumed twice on the "other" layout
+        problem, solver = _model()
+        writer = ResultWriter(out_run, comm, u=problem.u, resume=True)
+        for inc in load_path(problem, solver, times, verbose=False, checkpoint=directory,
+                             resume=directory, outputs=[writer], max_steps=stop and 1):
+            writer.write(inc)
+        solver.destroy()
+    if comm.rank == 0:
+        from rough_contact.io.files import parse_xdmf
+
+        t_run, u_run = _xdmf_steps(f"{out_run}/displacement.xdmf")
+        t_ref, u_ref = _xdmf_steps(f"{out_ref}/displacement.xdmf")
+        assert t_run == t_ref and len(t_ref) == 6
+        for t in t_ref:
+            np.testing.assert_allclose(u_run[t], u_ref[t], rtol=0,
+                                       atol=1e-12 * np.abs(u_ref[t_ref[-1]]).max())
+        text = open(f"{out_run}/displacement.xdmf").read()
+        root = parse_xdmf(f"{out_run}/displacement.xdmf")
+        names = [g.get("Name") for g in root.find("Domain").findall("Grid")]
+        assert names == ["mesh", "displacement", "mesh_ffffffffffff"]
+        assert text.count("@Name='mesh_ffffffffffff'") == 3      # steps 4, 5, 6
+    comm.Barrier()

@@ -6,7 +6,9 @@ Reference: the same amplitude run without interruption. A run stopped after 5 in
 run's hysteresis loop (u_x, F_x) and dissipation to 1e-12, and its per-increment CSV holds every
 increment once. The all-amplitudes driver restarted from a checkpoint directory reads back a
 finished amplitude without solving it again (same loop, 0 Newton iterations spent on it) and runs
-the missing one. Units: mm, N, MPa.
+the missing one. The joint's interface stiffness measured at the end of the preload is kept
+with the checkpoint: a run continued past the preload reports the uninterrupted run's value
+(issue 24: it printed NaN). Units: mm, N, MPa.
 """
 
 from __future__ import annotations
@@ -39,6 +41,11 @@ def test_stopped_amplitude_continues(tmp_path):
         np.testing.assert_allclose(getattr(rest, key), getattr(full, key), rtol=0,
                                    atol=1e-12 * scale, err_msg=key)
     assert full.dissipation[-1] > 0.0                         # it slipped: history matters
+    # issue 24: the continued run started past the preload (step 2) and reported the joint's
+    # stiffness as NaN; it is kept with the checkpoint and equals the uninterrupted run's
+    assert np.isfinite(full.k_normal) and full.k_normal > 0.0
+    assert rest.k_normal == pytest.approx(full.k_normal, rel=1e-12)
+    assert rest.k_tangential == pytest.approx(full.k_tangential, rel=1e-12)
     if MPI.COMM_WORLD.rank == 0:
         with open(loop) as f:
             rows = list(csv.DictReader(f))
@@ -55,6 +62,10 @@ def test_driver_restart_reads_finished_amplitudes(tmp_path):
     np.testing.assert_allclose(again[0].fx, first[0].fx, rtol=0,
                                atol=1e-12 * np.abs(first[0].fx).max())
     assert again[1].solved == len(again[1].t) == len(first[0].t)
+    # the amplitude read back reports the stiffness its run measured (was NaN: issue 24); it is
+    # what the driver prints as "preloaded joint: interface normal stiffness ..."
+    assert again[0].k_normal == pytest.approx(first[0].k_normal, rel=1e-12)
+    assert np.isfinite(again[0].k_tangential) and again[0].k_tangential > 0.0
     assert again[1].dissipation[-1] > again[0].dissipation[-1]
     with pytest.raises(ValueError, match="max_steps = 0 is invalid"):
         fretting.run_amplitude(0.5, stop_after=0, **SMALL)

@@ -48,6 +48,10 @@ class MortarPairing:
         self.second_tag = second_tag
         self.search_radius = search_radius
 
+    def describe(self) -> dict:
+        """Its options (``rough_contact.fingerprint.Describable``): what a checkpoint records."""
+        return dict(second_tag=int(self.second_tag), search_radius=self.search_radius)
+
     def pair(self, ctx: SurfaceContext) -> PairedPoints:
         """Points on the pieces and their partners (collective).
 

@@ -44,6 +44,10 @@ class ProjectionPairing:
         self._ctx: Optional[SurfaceContext] = None
         self._second: Optional[GatheredSurface] = None
 
+    def describe(self) -> dict:
+        """Its options (``rough_contact.fingerprint.Describable``): what a checkpoint records."""
+        return dict(second_tag=int(self.second_tag), search_radius=self.search_radius)
+
     def pair(self, ctx: SurfaceContext) -> PairedPoints:
         """Set-up projection of the undeformed surfaces (collective).
 
