@@ -143,7 +143,11 @@ def pair_auto(ctx, second_tag, match_tolerance, search_radius):
     if paired is not None:
         return conforming, paired
     projection = ProjectionPairing(second_tag, search_radius)
-    return projection, projection.pair(ctx)
+    try:
+        return projection, projection.pair(ctx)
+    except ValueError as exc:       # raised on every rank together (collective checks)
+        raise ValueError(f"pairing = 'auto': surfaces {ctx.first_tag} and {second_tag} do not "
+                         f"match facet to facet, so the projection was tried: {exc}") from exc
 
 
 def initial_law_state(law, n: int, comm) -> LawState:

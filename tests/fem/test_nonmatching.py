@@ -347,3 +347,27 @@ def test_two_xdmf_files_make_one_scene(tmp_path, order):
     with pytest.raises(ValueError, match="does not exist"):
         scene_from_xdmf_files([(f"{folder}/none.xdmf", {})], comm, contact_pair=("a", "b"))
 
+
+
+@pytest.mark.parametrize("pairing", ["projection", "auto"])
+def test_larger_first_surface_says_swap(pairing):
+    """Issue 24, item 12: a slab 3 mm long given as the first surface and a slider 1 mm long
+    as the second: the slab's points beyond the slider's edge have no partner and no search
+    radius gives them one. The error says which surface is larger and to swap them, as the
+    mortar's does, instead of "raise search_radius"; with the surfaces swapped it pairs."""
+    from rough_contact.scenes.meshes.blocks import slider_on_slab
+
+    scene = slider_on_slab(size_slab=0.25, size_slider=0.2)
+    V = compat.vector_space(scene.mesh, 1)
+    slider, slab = scene.contact_pair
+    with pytest.raises(ValueError) as err:
+        ContactInterface(V, scene.facet_tags, slab, slider, law=LinearPenalty(1.0),
+                         pairing=pairing, search_radius=10.0)
+    msg = str(err.value)
+    assert f"Surface {slab} (1.5 mm^2) is larger than surface {slider} (0.5 mm^2)" in msg
+    assert "swap first_tag and second_tag" in msg and "raise search_radius" not in msg
+    assert ("pairing = 'auto'" in msg) == (pairing == "auto")
+    ci = ContactInterface(V, scene.facet_tags, slider, slab, law=LinearPenalty(1.0),
+                          pairing=pairing)
+    assert ci.pairing_used == "projection"
+    assert abs(ci.nominal_area() - 0.5) <= 1e-12
