@@ -74,6 +74,11 @@ def patch(cell_type, order, size_lower, size_upper, first, pairing, law, E_lower
     slipping = c.allreduce(int(pf.slipping[real].sum()), op=MPI.SUM)
     force = ci.contact_force()
     summary = ci.summary()
+    # issue 24, item 11: the header's count (n_points_global) is the increments' count, the
+    # points with weight; the mortar's slot-filling copies are counted apart (n_slots_global)
+    n_real = c.allreduce(int(real.sum()), op=MPI.SUM)
+    assert ci.n_points_global == summary.n_points == n_real
+    assert ci.n_slots_global == c.allreduce(ci.n_points, op=MPI.SUM) >= n_real
     facets = facet_output(ci)          # what the XDMF writer writes per facet
     f_err = c.allreduce(float(np.max(np.abs(facets.pressure - p), initial=0.0)), op=MPI.MAX)
     assert f_err <= 1e-8 * p
