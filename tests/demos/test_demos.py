@@ -116,6 +116,31 @@ def test_uncaught_exception_on_some_ranks_aborts(tmp_path):
     assert "rank 1: ValueError: steps = 0 is invalid (rank 1 of 2)" in every.stderr
 
 
+def _readme_snippet() -> str:
+    """The python block under "## What it does" in README.md."""
+    text = (ROOT / "README.md").read_text()
+    section = text[text.index("## What it does"):]
+    start = section.index("```python\n") + len("```python\n")
+    return section[start:section.index("```\n", start)]
+
+
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_readme_snippet(tmp_path, ranks):
+    """The README's script runs as it stands (serial and 2 ranks): one line per increment of
+    the load path 0.25 ... 1 ... 0.25, the contact force equal to the applied 250 N times the
+    load factor (the interface carries the whole load: force balance, 4 digits printed)."""
+    if ranks > 1 and MPIRUN is None:
+        pytest.skip("mpirun not found")
+    script = tmp_path / "readme_snippet.py"
+    script.write_text(_readme_snippet())
+    out = run([script], tmp_path, ranks)
+    rows = [ln.split() for ln in out.splitlines() if ln.startswith("load ")]
+    loads = [float(r[1].rstrip(":")) for r in rows]
+    assert loads == [0.25, 0.5, 0.75, 1.0, 0.75, 0.5, 0.25]
+    for lam, r in zip(loads, rows):
+        assert float(r[4]) == pytest.approx(250.0 * lam, abs=0.006), r
+
+
 def test_show_scene_mesh(tmp_path):
     out = run([DEMOS / "show_scene_mesh.py", "flat_punch", "--mesh-size", "40",
                "--contact-size", "10", "--xdmf", tmp_path / "punch.xdmf"], tmp_path)
