@@ -22,8 +22,9 @@ propagates at once with its type and traceback: no cutback, no LoadStepError.
 
 A failed step whose applied tangential force exceeds what friction can carry (mu_max of a
 ``FrictionBoundedLaw`` times the normal force: the applied one, or the one the interface carried
-at the last converged increment if larger, as under a prescribed normal displacement) raises :class:`FrictionCapacityError`
-(a ``LoadStepError``) at once instead of cutting back: the body slides (``friction_check``).
+at the last converged increment if larger, as under a prescribed normal displacement) raises
+:class:`FrictionCapacityError` (a ``LoadStepError``) at once instead of cutting back: the body
+slides (``friction_check``).
 
 Guards before and after each solve:
 
@@ -258,8 +259,9 @@ def load_path(problem: ContactProblem, solver: SNESSolver, factors: Iterable[flo
             (relative to the first surface's mean normal) with mu_max times the normal force:
             the larger of the applied normal force and the normal force the interface carried
             at the last converged increment (a normal load by prescribed displacement applies
-            no force but is carried); if it is larger, raise :class:`FrictionCapacityError` instead of cutting back (the
-            body slides). Turn it off for a body that other supports hold tangentially.
+            no force but is carried); if it is larger, raise :class:`FrictionCapacityError`
+            instead of cutting back (the body slides). Turn it off for a body that other
+            supports hold tangentially.
         checkpoint: directory receiving a checkpoint after every converged increment
             (``rough_contact.solver.checkpoint``: atomic, two alternating slots). The
             checkpoint of an increment is written when the caller asks for the next one (after

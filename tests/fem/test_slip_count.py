@@ -17,8 +17,6 @@ from __future__ import annotations
 
 import csv
 
-import numpy as np
-import pytest
 from mpi4py import MPI
 
 from rough_contact.fem.boundary import fix
