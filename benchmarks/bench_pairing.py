@@ -1,6 +1,7 @@
 """Non-matching interfaces: patch-test accuracy of the pairings, and their cost at scale.
 
-    OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bench_pairing.py [--part accuracy|cost|all]
+    OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bench_pairing.py
+        [--part accuracy|points|cost|all]
         [--points 10000 50000 200000] [--pairings conforming projection mortar moderate]
     ... --part newton [--points 10000 50000]  (also under mpirun -n 2)
 
@@ -10,6 +11,12 @@ p = 80 MPa on top, bilateral linear penalty 1e6 MPa/mm, lower block E/2: largest
 (``pairing="projection"``, facet rule of degree 2 x order, and a richer rule) and the
 segment-to-segment integration (``pairing="mortar"``, triangle rule of degree 2 x order on the
 pieces).
+
+Part "points": the interface points of the accuracy part's meshes (set-up only): the Gauss
+projection's (rule of degree 2 x order), the mortar's points (pieces x triangle rule of degree
+2 x order, points with weight) and its point slots (every first facet padded to the largest
+count with weight-0 copies: the law is evaluated at every slot), and the ratios to the
+projection's points.
 
 Part "cost": thin hexahedral blocks (Q1, one element layer each, facet rule of degree 2: 4 points
 per facet) with about N interface points; equal element sizes (the conforming pairing applies)
@@ -81,6 +88,29 @@ def patch_error(cell_type, order, size_lower, size_upper, first, pairing, degree
     n = MPI.COMM_WORLD.allreduce(int(real.sum()), op=MPI.SUM)
     solver.destroy()
     return err, n
+
+
+def points():
+    cases = [("tetrahedron", 1, 0.2, 0.28, "upper"), ("tetrahedron", 2, 0.2, 0.28, "upper"),
+             ("tetrahedron", 1, 0.3, 0.1, "lower"), ("tetrahedron", 1, 0.1, 0.3, "lower"),
+             ("hexahedron", 1, 1 / 5, 1 / 7, "upper"), ("hexahedron", 2, 1 / 5, 1 / 7, "upper"),
+             ("hexahedron", 1, 1 / 3, 1 / 9, "upper"), ("hexahedron", 1, 1 / 3, 1 / 9, "lower")]
+    PETSc.Sys.Print("interface points: Gauss projection (degree 2k) and mortar (degree 2k)")
+    PETSc.Sys.Print(f"{'cells':>5} {'P':>2} {'h_low':>6} {'h_up':>6} {'first':>6} "
+                    f"{'proj pts':>9} {'mortar pts':>10} {'slots':>7} {'pts/proj':>8} "
+                    f"{'slots/proj':>10}")
+    law = LinearPenalty(1e6)
+    for ct, order, hl, hu, first in cases:
+        scene = separate_blocks(h1=1.0, h2=0.5, size_lower=hl, size_upper=hu, order=order,
+                                cell_type=ct)
+        V = compat.vector_space(scene.mesh, order)
+        a, b = scene.contact_pair if first == "upper" else scene.contact_pair[::-1]
+        proj, mortar = (ContactInterface(V, scene.facet_tags, a, b, law=law,
+                                         quadrature_degree=2 * order, pairing=p)
+                        for p in ("projection", "mortar"))
+        n_p, n_m, n_s = proj.n_points_global, mortar.n_points_global, mortar.n_slots_global
+        PETSc.Sys.Print(f"{ct[:5]:>5} {order:2d} {hl:6.3f} {hu:6.3f} {first:>6} {n_p:9d} "
+                        f"{n_m:10d} {n_s:7d} {n_m / n_p:8.1f} {n_s / n_p:10.1f}")
 
 
 def accuracy():
@@ -220,13 +250,16 @@ def newton(points, only=None):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--part", choices=["accuracy", "cost", "newton", "all"], default="all")
+    ap.add_argument("--part", choices=["accuracy", "points", "cost", "newton", "all"],
+                    default="all")
     ap.add_argument("--points", type=int, nargs="+", default=[10000, 50000, 200000])
     ap.add_argument("--pairings", nargs="+", default=None,
                     choices=["conforming", "projection", "mortar", "moderate"])
     args = ap.parse_args(argv)
     if args.part in ("accuracy", "all"):
         accuracy()
+    if args.part in ("points", "all"):
+        points()
     if args.part in ("cost", "all"):
         cost(args.points, args.pairings)
     if args.part in ("newton", "all"):

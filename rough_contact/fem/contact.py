@@ -104,9 +104,11 @@ class ContactInterface(InterfaceQueries):
         bcs: Dirichlet conditions whose DOFs the interface must not touch.
         match_tolerance: conforming vertex matching tolerance relative to the facet size, > 0.
         pairing: ``"auto"`` (conforming if every facet finds its match, else projection),
-            ``"conforming"``, ``"projection"``, ``"mortar"`` (segment-to-segment: passes the
-            patch test on non-matching meshes), or any
-            :class:`~rough_contact.fem.pairing.Pairing` object.
+            ``"conforming"``, ``"projection"`` (Gauss points projected along the normal: cheap,
+            fails the patch test on non-nested meshes), ``"mortar"`` (segment-to-segment:
+            passes the patch test on non-matching meshes; Gauss rule only), or any
+            :class:`~rough_contact.fem.pairing.Pairing` object, e.g.
+            ``AutoPairing(second_tag, "mortar")`` (conforming, else mortar).
         search_radius: projection/mortar: largest accepted normal distance to a partner [mm].
         sliding: ``"small"`` (partners found once) or ``"moderate"`` (the projection redone on
             the deformed surfaces at the start of every increment: ``begin_increment``).
@@ -117,7 +119,13 @@ class ContactInterface(InterfaceQueries):
         history: law state, multipliers and pairing (``InterfaceHistory``).
         paired: the pairing's points; operator: the jump operator.
         pairing_used: ``"conforming"``, ``"projection"``, ``"mortar"`` or ``"rigid"``.
-        n_points, n_points_global, n_facets, n_qp, n_groups, n_remote_partners, n_repairs.
+        n_points: this rank's point slots (the length of every per-point array; the mortar
+            pairing's weight-0 slot-filling copies included).
+        n_points_global: global number of interface points, without those copies (what
+            ``summary().n_points`` and the increments count).
+        n_slots_global: global number of point slots, copies included (the law is evaluated
+            at every slot; equal to n_points_global except for the mortar pairing).
+        n_facets, n_qp, n_groups, n_remote_partners, n_repairs.
 
     Raises:
         TypeError: ``law`` does not satisfy the protocol, or the enforcement cannot use it.
@@ -177,7 +185,8 @@ class ContactInterface(InterfaceQueries):
             jump0[:, 0] += operator.gap0
         self._jump0 = jump0
         self.n_points = operator.n_points
-        self.n_points_global = self.comm.allreduce(self.n_points, op=MPI.SUM)
+        self.n_points_global, self.n_slots_global = self.comm.allreduce(
+            np.array([int(operator.own_slot.sum()), self.n_points]), op=MPI.SUM).tolist()
         self.n_facets, self.n_qp = self.paired.facets.size, self.paired.n_qp
         self.n_groups, self.n_remote_partners = operator.n_groups, operator.n_remote_partners
 

@@ -19,6 +19,7 @@ from rough_contact.fem.collective import raise_on_all_ranks
 from rough_contact.fem.pairing import (ConformingPairing, MortarPairing, Pairing,
                                        ProjectionPairing, RigidPairing,
                                        SlidingProjectionPairing)
+from rough_contact.fem.pairing.auto import AutoPairing
 from rough_contact.fem.pairing.facets import CELLS
 from rough_contact.fem.rigid import RigidPlane as RigidPlaneSurface
 from rough_contact.fem.rigid import RigidSurface
@@ -138,12 +139,9 @@ def select_pairing(V, pairing: Union[str, Pairing], second_tag: Optional[int],
 def pair_auto(ctx, second_tag, match_tolerance, search_radius):
     """``"auto"``: the conforming pairing if every facet finds its match, else the projection
     (collective). Returns (pairing object, paired points)."""
-    conforming = ConformingPairing(second_tag, match_tolerance, strict=False)
-    paired = conforming.pair(ctx)
-    if paired is not None:
-        return conforming, paired
-    projection = ProjectionPairing(second_tag, search_radius)
-    return projection, projection.pair(ctx)
+    auto = AutoPairing(second_tag, "projection", match_tolerance, search_radius)
+    paired = auto.pair(ctx)
+    return auto.chosen, paired
 
 
 def initial_law_state(law, n: int, comm) -> LawState:

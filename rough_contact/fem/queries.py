@@ -33,12 +33,13 @@ class InterfaceSummary:
         n_points: number of interface quadrature points (without the weight-0 copies that
             fill the slots of the mortar pairing).
         n_contact: points with p > 0.
-        n_slipping: points where the friction limit is active.
+        n_slipping: points in contact where the friction limit is active (a point out of
+            contact is open, never counted as slipping, whatever the law reports).
         contact_force: (3,) force on the FIRST body's surface in global axes [N].
         real_area: real contact area int A/A0 dA [mm^2].
         nominal_area: area of the first contact surface [mm^2].
         contact_area: nominal area of the points in contact [mm^2].
-        slipping_area: nominal area of the slipping points [mm^2].
+        slipping_area: nominal area of the slipping points (in contact) [mm^2].
         max_slip: largest |(s_x, s_y)| [mm].
         max_plastic_slip: largest |plastic slip| of the trial state [mm].
         dissipation: committed accumulated frictional dissipation int D dA [N mm].
@@ -73,7 +74,7 @@ class PointFields:
         plastic_slip: (n, 2) plastic slip of the trial state [mm].
         dissipation: (n,) committed accumulated dissipation per area [N/mm].
         contact: (n,) bool.
-        slipping: (n,) bool.
+        slipping: (n,) bool, in contact and slipping.
         weight: (n,) quadrature weight = area represented by the point [mm^2].
     """
 
@@ -147,10 +148,11 @@ class InterfaceQueries:
         w = self.paired.weights
         own = self.operator.own_slot  # counts skip the mortar pairing's slot-filling copies
         force = np.einsum("pai,pa,p->i", self.paired.frames, res.traction, w)
+        slipping = res.slipping & res.contact   # a point out of contact is open (any law)
         sums = np.concatenate([force, [
             float(np.dot(res.area_fraction, w)), float(w.sum()), float(w[res.contact].sum()),
-            float(w[res.slipping].sum()), float(np.dot(self.history.law.dissipated, w)),
-            float((res.contact & own).sum()), float((res.slipping & own).sum()),
+            float(w[slipping].sum()), float(np.dot(self.history.law.dissipated, w)),
+            float((res.contact & own).sum()), float((slipping & own).sum()),
             0.0 if res.beyond_validity is None else float((res.beyond_validity & own).sum()),
             float(own.sum())]])
         sums = self.comm.allreduce(sums, op=MPI.SUM)
@@ -196,7 +198,7 @@ class InterfaceQueries:
             plastic_slip=np.array(self.history.law.trial.plastic_slip, dtype=float),
             dissipation=self.history.law.dissipated.copy(),
             contact=np.asarray(res.contact),
-            slipping=np.asarray(res.slipping),
+            slipping=np.asarray(res.slipping) & np.asarray(res.contact),
             weight=self.paired.weights,
         )
 

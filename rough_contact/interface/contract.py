@@ -119,7 +119,8 @@ class LawResult:
         dissipation: (n,) float dissipation increment t_T . Delta s_p >= 0 of this step [N/mm].
         area_fraction: (n,) float real-area fraction A/A0 in [0, 1] [-].
         contact: (n,) bool, p > 0 (the point carries load).
-        slipping: (n,) bool, the friction limit is active.
+        slipping: (n,) bool, in contact and the friction limit is active (False wherever
+            ``contact`` is False: a point out of contact is open, not slipping).
         beyond_validity: (n,) bool, True where the law is evaluated outside the range its model
             is valid for (e.g. a statistical normal law below its lowest tabulated separation,
             where a stiff continuation stands in for the model); ``None`` for a law without

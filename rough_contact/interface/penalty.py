@@ -92,6 +92,9 @@ class SoftplusPenalty:
     g << -w, p -> 0 for g >> w, and k = -dp/dg = k_N sigmoid(-g / w) (C-infinity).
     Tangential: elastic predictor tau = k_T (s - s_p); if |tau| > mu p the point slips
     (radial return): t_T = mu p tau / |tau|, s_p += (|tau| - mu p) / k_T * tau / |tau|.
+    A point without pressure (p = 0, where the softplus underflows far from contact) returns
+    to t_T = 0 the same way but is reported as open, not slipping (``LawResult.slipping`` is
+    False outside contact).
     The tangent is the consistent (non-symmetric) one. ``area_fraction`` = sigmoid(-g / w)
     is a toy measure (0 far open, 1 deep in contact).
 
@@ -206,26 +209,29 @@ class SoftplusPenalty:
             limit = self.friction * p
             # a relative margin keeps points exactly on the cone (e.g. re-evaluated after a
             # commit) elastic instead of slipping by round-off
-            slipping = norm > limit * (1.0 + 1e-12)
-            stick = ~slipping
+            ret = norm > limit * (1.0 + 1e-12)      # radial return (also where p = 0)
+            stick = ~ret
             traction[stick, 1:] = tau[stick]
             tangent[stick, 1, 1] = kt
             tangent[stick, 2, 2] = kt
-            if np.any(slipping):
-                ns = norm[slipping]
-                m = tau[slipping] / ns[:, None]
-                ls = limit[slipping]
-                traction[slipping, 1:] = ls[:, None] * m
+            if np.any(ret):
+                ns = norm[ret]
+                m = tau[ret] / ns[:, None]
+                ls = limit[ret]
+                traction[ret, 1:] = ls[:, None] * m
                 ratio = ls * kt / ns
-                tangent[slipping, 1:, 1:] = ratio[:, None, None] * (
+                tangent[ret, 1:, 1:] = ratio[:, None, None] * (
                     np.eye(2)[None] - m[:, :, None] * m[:, None, :]
                 )
-                tangent[slipping, 1:, 0] = -self.friction * k[slipping][:, None] * m
+                tangent[ret, 1:, 0] = -self.friction * k[ret][:, None] * m
                 dslip = ((ns - ls) / kt)[:, None] * m
-                state.plastic_slip[slipping] += dslip
-                state.accumulated_slip[slipping] += np.abs(dslip)
-                state.slip_path[slipping] += (ns - ls) / kt
-                dissipation[slipping] = np.einsum("ij,ij->i", traction[slipping, 1:], dslip)
+                state.plastic_slip[ret] += dslip
+                state.accumulated_slip[ret] += np.abs(dslip)
+                state.slip_path[ret] += (ns - ls) / kt
+                dissipation[ret] = np.einsum("ij,ij->i", traction[ret, 1:], dslip)
+            # a point out of contact (p = 0: zero limit, zero traction) follows the other
+            # surface freely; it is open, not slipping (the counters count slip in contact)
+            slipping = ret & (p > 0.0)
         return LawResult(
             traction=traction,
             tangent=tangent,

@@ -17,15 +17,16 @@ import importlib
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:  # the same names as _SOURCES, spelled as imports for readers and checkers
-    from .files import (RUN_OUTPUT_PATTERNS, OutputExistsError, atomic_write,  # noqa: F401
-                        atomic_write_text, prepare_output_dir)
+    from .files import (RUN_OUTPUT_PATTERNS, OutputExistsError, OutputWriteError,  # noqa: F401
+                        atomic_write, atomic_write_text, prepare_output_dir)
     from .interface_output import (InterfaceResults, InterfaceWriter,  # noqa: F401
                                    pseudo_time, read_interface_results)
     from .results import CsvRecorder, ResultWriter, gather_points  # noqa: F401
 
 # public name -> module of this package that defines it
 _SOURCES = {
-    "RUN_OUTPUT_PATTERNS": "files", "OutputExistsError": "files", "atomic_write": "files",
+    "RUN_OUTPUT_PATTERNS": "files", "OutputExistsError": "files", "OutputWriteError": "files",
+    "atomic_write": "files",
     "atomic_write_text": "files", "prepare_output_dir": "files",
     "InterfaceResults": "interface_output", "InterfaceWriter": "interface_output",
     "pseudo_time": "interface_output", "read_interface_results": "interface_output",

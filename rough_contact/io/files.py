@@ -3,6 +3,10 @@
 * :func:`atomic_write` (and :func:`atomic_write_text`): a temporary file, fsync,
   ``os.replace``; every file the writers of :mod:`rough_contact.io` write goes through it, so a
   crash leaves the old file or the new one, never a truncated one.
+* a write that fails (a full disk, a quota, permissions) raises :class:`OutputWriteError`, one
+  message naming the file and the cause (:func:`write_failure`, :func:`writing`);
+  :func:`check_free_space` refuses a write that the free space cannot hold before it starts
+  (an HDF5 file that runs out of space half-way cannot even be closed).
 * :func:`prepare_output_dir` makes a folder hold exactly one run: it refuses a folder with
   results of an earlier run unless ``overwrite=True``, and then removes those files (only the
   files this project's writers produce, ``RUN_OUTPUT_PATTERNS``).
@@ -10,16 +14,19 @@
 
 from __future__ import annotations
 
+import contextlib
+import errno
 import os
 import re
-from typing import Iterable, Sequence, Union
+from typing import Iterable, Optional, Sequence, Union
 
 from mpi4py import MPI
 
 from rough_contact.fem.collective import run_on_root
 
-__all__ = ["atomic_write", "atomic_write_text", "OutputExistsError", "RUN_OUTPUT_PATTERNS",
-           "prepare_output_dir", "run_files"]
+__all__ = ["atomic_write", "atomic_write_text", "OutputExistsError", "OutputWriteError",
+           "RUN_OUTPUT_PATTERNS", "prepare_output_dir", "run_files", "free_bytes",
+           "check_free_space", "write_failure", "writing"]
 
 # Files the project's writers produce in an output folder (ResultWriter: displacement, history,
 # the former point cloud with its per-step .bin files; InterfaceWriter: the surface files), and
@@ -34,11 +41,109 @@ class OutputExistsError(FileExistsError, ValueError):
     """An output folder holds results of an earlier run and ``overwrite`` was not given."""
 
 
+class OutputWriteError(OSError):
+    """An output file could not be written; the message names the file and the cause (e.g. no
+    space left on device, with the free space). ``errno`` and ``filename`` are set when known."""
+
+    def __str__(self) -> str:
+        return str(self.args[0]) if self.args else super().__str__()
+
+
+_SPACE_ERRORS = {errno.ENOSPC: "no space left on device", errno.EDQUOT: "disk quota exceeded",
+                 errno.EFBIG: "file too large"}
+
+
+def _folder(path: str) -> str:
+    """The nearest existing folder at or above ``path``'s folder."""
+    folder = os.path.dirname(os.path.abspath(os.fspath(path)))
+    while not os.path.isdir(folder) and os.path.dirname(folder) != folder:
+        folder = os.path.dirname(folder)
+    return folder
+
+
+def free_bytes(path: str) -> int:
+    """Bytes an unprivileged writer can still write on the file system holding ``path``."""
+    st = os.statvfs(_folder(path))
+    return int(st.f_bavail) * int(st.f_frsize)
+
+
+def _size(n: float) -> str:
+    for unit, scale in (("GB", 1e9), ("MB", 1e6), ("kB", 1e3)):
+        if n >= scale:
+            return f"{n / scale:.3g} {unit}"
+    return f"{int(n)} bytes"
+
+
+def _errno_of(exc: BaseException) -> Optional[int]:
+    """The errno of an OSError, or the one HDF5 puts in its messages ('errno = 28'), following
+    the chain of causes."""
+    while exc is not None:
+        if isinstance(exc, OSError) and exc.errno:
+            return int(exc.errno)
+        found = re.search(r"errno = (\d+)", str(exc))
+        if found:
+            return int(found.group(1))
+        if "No space left on device" in str(exc):
+            return errno.ENOSPC
+        exc = exc.__cause__ or exc.__context__
+    return None
+
+
+def write_failure(path: str, exc: BaseException, min_free: int = 64 * 1024) -> OutputWriteError:
+    """The clear error for a failed write of ``path`` (``exc``: what the writer raised). The
+    cause is the errno of ``exc`` when it has one (also in HDF5's messages), else a file system
+    with less than ``min_free`` bytes free is taken for a full disk."""
+    path = os.fspath(path)
+    code = _errno_of(exc)
+    try:
+        free = free_bytes(path)
+    except OSError:
+        free = None
+    if code is None and free is not None and free < min_free:
+        code = errno.ENOSPC
+    if code in _SPACE_ERRORS:
+        where = "" if free is None else f" ({_size(free)} free on the file system of " \
+            f"{_folder(path)})"
+        message = (f"cannot write {path}: {_SPACE_ERRORS[code]}{where}; free some space or "
+                   "write the results to another folder")
+    else:
+        message = f"cannot write {path}: {type(exc).__name__}: {exc}"
+    err = OutputWriteError(message)
+    err.errno, err.filename = code, path
+    return err
+
+
+@contextlib.contextmanager
+def writing(path: str):
+    """Turn an OSError or RuntimeError (HDF5's failures) raised inside into
+    :func:`write_failure` of ``path``."""
+    try:
+        yield
+    except OutputWriteError:
+        raise
+    except (OSError, RuntimeError) as exc:
+        raise write_failure(path, exc) from exc
+
+
+def check_free_space(path: str, needed: int, what: str) -> None:
+    """Raise :class:`OutputWriteError` before writing when the file system of ``path`` has less
+    than ``needed`` bytes free (``what``: the files about to be written, for the message)."""
+    free = free_bytes(path)
+    if free < needed:
+        err = OutputWriteError(
+            f"cannot write {what}: no space left on device ({_size(free)} free on the file "
+            f"system of {_folder(path)}, the step needs about {_size(needed)}); free some space "
+            "or write the results to another folder")
+        err.errno, err.filename = errno.ENOSPC, os.fspath(path)
+        raise err
+
+
 def atomic_write(path: str, content: Union[str, bytes, Iterable[bytes]]) -> None:
     """Write ``content`` to ``path`` atomically: a temporary file, fsync, ``os.replace``.
 
     A crash leaves either the old file or the new one, never a truncated one. Every file the
-    output writers write goes through here.
+    output writers write goes through here. A failed write (e.g. a full disk) removes the
+    temporary file and raises :class:`OutputWriteError` naming ``path`` and the cause.
 
     Args:
         path: destination.
@@ -52,12 +157,17 @@ def atomic_write(path: str, content: Union[str, bytes, Iterable[bytes]]) -> None
     else:
         chunks = content
     tmp = f"{path}.tmp{os.getpid()}"
-    with open(tmp, "wb") as fh:
-        for chunk in chunks:
-            fh.write(chunk)
-        fh.flush()
-        os.fsync(fh.fileno())
-    os.replace(tmp, path)
+    try:
+        with open(tmp, "wb") as fh:
+            for chunk in chunks:
+                fh.write(chunk)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except OSError as exc:
+        with contextlib.suppress(OSError):
+            os.remove(tmp)
+        raise write_failure(path, exc) from exc
 
 
 def atomic_write_text(path: str, text: str) -> None:

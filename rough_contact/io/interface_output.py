@@ -60,7 +60,8 @@ from mpi4py import MPI
 from rough_contact.fem import compat
 from rough_contact.fem.collective import run_on_root
 from rough_contact.fem.contact import PointFields
-from rough_contact.io.files import OutputExistsError, atomic_write_text, parse_xdmf, run_files
+from rough_contact.io.files import (OutputExistsError, atomic_write_text, check_free_space,
+                                   parse_xdmf, run_files, writing)
 
 __all__ = [
     "STATUS_OPEN", "STATUS_STICK", "STATUS_SLIP", "STATUS_NAMES", "InterfaceOutputSource",
@@ -432,7 +433,8 @@ class InterfaceWriter:
         self.surface = surface
 
         def create():
-            os.makedirs(self.outdir, exist_ok=True)
+            with writing(self.outdir):
+                os.makedirs(self.outdir, exist_ok=True)
             # points: facet by facet in the surface's facet order, by coordinates within a facet
             x = xq["x"].reshape(-1, n_qp, 3)[surface.order]
             fid = np.repeat(np.arange(x.shape[0]), n_qp)
@@ -460,7 +462,7 @@ class InterfaceWriter:
     def _new_h5(self) -> None:
         import h5py
 
-        with h5py.File(self.h5_path, "w") as h5:
+        with writing(self.h5_path), h5py.File(self.h5_path, "w") as h5:
             h5["Mesh/geometry"] = self.surface.points
             h5["Mesh/topology"] = self.surface.cells
             if self.points:
@@ -603,7 +605,12 @@ class InterfaceWriter:
             self._specs = {g: {n: (a.shape, a.dtype) for n, a in d.items()}
                            for g, d in data.items()}
             group = f"Step_{k + 1:04d}"
-            with h5py.File(self.h5_path, "a") as h5:
+            # refused before HDF5 starts: a file that runs out of space half-way cannot be
+            # closed cleanly (h5py then fails in its destructors)
+            needed = sum(a.nbytes for d in data.values() for a in d.values())
+            check_free_space(self.h5_path, int(1.25 * needed) + 64 * 1024,
+                             f"step {k + 1} to {self.h5_path}")
+            with writing(self.h5_path), h5py.File(self.h5_path, "a") as h5:
                 if group in h5:  # left by a failed earlier attempt at this step: not listed
                     del h5[group]
                 for g, d in data.items():

@@ -28,7 +28,9 @@ that was written stays readable:
 
 from __future__ import annotations
 
+import contextlib
 import csv
+import ctypes
 import hashlib
 import io
 import os
@@ -43,7 +45,9 @@ from dolfinx import fem
 from dolfinx.io import XDMFFile
 from rough_contact.fem import compat
 from rough_contact.fem.collective import run_on_root
-from rough_contact.io.files import atomic_write, atomic_write_text, parse_xdmf, prepare_output_dir
+from rough_contact.io.files import (atomic_write, atomic_write_text, check_free_space,
+                                   parse_xdmf, prepare_output_dir,
+                                   write_failure)
 from rough_contact.io.interface_output import InterfaceWriter, pseudo_time
 
 __all__ = ["ResultWriter", "CsvRecorder", "gather_points", "truncate_time_series"]
@@ -191,6 +195,10 @@ class ResultWriter:
         self.csv_path = os.path.join(self.outdir, "history.csv")
         self.u_path = os.path.join(self.outdir, "displacement.xdmf")
         self._layout_now = self._layout()
+        # interface points and facets of all ranks (for the free-space estimate)
+        n_local = 0 if interface is None else len(interface.point_weights())
+        self._interface_slots = comm.allreduce(
+            0 if interface is None else n_local + n_local // max(interface.n_qp, 1), op=MPI.SUM)
 
     # ------------------------------------------------------------------ displacement
     def _write_displacement(self, t: float) -> None:
@@ -200,21 +208,34 @@ class ResultWriter:
         msh = self.u.function_space.mesh
         if not self._xdmf_started:
             self._mesh_name, self._mesh_written = None, True
-        with XDMFFile(self.comm, self.u_path, mode) as xdmf:
-            if not self._xdmf_started:
-                xdmf.write_mesh(msh)
-            if self._mesh_name is None:
-                xdmf.write_function(self._u_out, t)
-            else:           # a resumed run on another partition: its own mesh grid (restore)
-                if not self._mesh_written:
-                    name, msh.name = msh.name, self._mesh_name
-                    try:
-                        xdmf.write_mesh(msh)
-                    finally:
-                        msh.name = name
-                    self._mesh_written = True
-                xdmf.write_function(self._u_out, t,
-                                    mesh_xpath=f"/Xdmf/Domain/Grid[@Name='{self._mesh_name}'][1]")
+        xdmf = None
+        try:
+            with _quiet_hdf5():
+                xdmf = XDMFFile(self.comm, self.u_path, mode)
+                if not self._xdmf_started:
+                    xdmf.write_mesh(msh)
+                if self._mesh_name is None:
+                    xdmf.write_function(self._u_out, t)
+                else:       # a resumed run on another partition: its own mesh grid (restore)
+                    if not self._mesh_written:
+                        name, msh.name = msh.name, self._mesh_name
+                        try:
+                            xdmf.write_mesh(msh)
+                        finally:
+                            msh.name = name
+                        self._mesh_written = True
+                    xdmf.write_function(
+                        self._u_out, t,
+                        mesh_xpath=f"/Xdmf/Domain/Grid[@Name='{self._mesh_name}'][1]")
+                xdmf.close()
+        except RuntimeError as exc:
+            # HDF5 failed (e.g. the disk ran full during the write). No collective here: a
+            # rank of DOLFINx's writer may fail while another goes on into the writer's next
+            # collective, so agreeing on the failure would hang; each failing rank raises the
+            # clear error (an entry script's abort_on_uncaught_exception ends the job).
+            if xdmf is not None:
+                _never_destroy(xdmf)
+            raise write_failure(os.path.splitext(self.u_path)[0] + ".h5", exc) from exc
         self._xdmf_started = True
         self._xdmf_steps += 1
 
@@ -229,6 +250,23 @@ class ResultWriter:
         if self.comm.rank == 0:
             digest = hashlib.sha256(np.concatenate(every).astype(np.int64).tobytes()).hexdigest()
         return self.comm.bcast(digest, root=0)
+
+    def _bytes_per_step(self) -> int:
+        """An upper estimate of what one :meth:`write` adds to the folder [bytes]: the
+        displacement values (and the mesh at the first step), the interface's facet and point
+        fields (at most 24 values each; 20 are written), 25 % for HDF5's own records and 128 kB
+        for the CSV and XML indexes."""
+        n = 0
+        if self.u is not None:
+            V = self._u_out.function_space
+            n += 8 * V.dofmap.index_map.size_global * V.dofmap.index_map_bs
+            if not self._xdmf_started:
+                msh = V.mesh
+                n += 8 * 3 * msh.geometry.index_map().size_global
+                n += 8 * msh.topology.index_map(msh.topology.dim).size_global * \
+                    compat.geometry_dofmap(msh).shape[1]
+        n += 8 * 24 * self._interface_slots
+        return int(1.25 * n) + 128 * 1024
 
     # ------------------------------------------------------------------ restart
     def checkpoint_state(self) -> dict:
@@ -265,14 +303,17 @@ class ResultWriter:
 
     # ------------------------------------------------------------------ CSV
     def _write_csv(self, inc, extra: Optional[dict]) -> None:
-        if self.comm.rank != 0:
-            return
+        """Append the row and rewrite the file on rank 0; a failure raises on every rank."""
         row = [getattr(inc, attr) for _, attr in _CSV_COLUMNS]
         row += list(np.asarray(inc.applied_force, dtype=float).reshape(3))
         row += list(np.asarray(inc.contact_force, dtype=float).reshape(3))
         row += [(extra or {}).get(k, "") for k in self.extra_columns]
-        self.rows.append(row)
-        self._flush_csv()
+
+        def act():
+            self.rows.append(row)
+            self._flush_csv()
+
+        run_on_root(self.comm, act)
 
     def _flush_csv(self) -> None:
         header = [c for c, _ in _CSV_COLUMNS] + ["applied_fx_N", "applied_fy_N", "applied_fz_N",
@@ -289,7 +330,19 @@ class ResultWriter:
         """Write increment ``inc`` (a :class:`~rough_contact.solver.loading.Increment`).
 
         Collective.
+
+        Raises:
+            OutputWriteError (every rank): the folder's file system has not the room for the
+                increment (checked before writing: an HDF5 file that runs out of space cannot
+                even be closed), or a write failed; the message names the file and the cause.
         """
+        needed = self._bytes_per_step()
+        files = ", ".join(os.path.basename(f) for f, on in (
+            (self.u_path.replace(".xdmf", ".h5"), self.u is not None),
+            (os.path.join(self.outdir, "interface.h5"), self.interface_writer is not None),
+            (self.csv_path, True)) if on)
+        run_on_root(self.comm, lambda: check_free_space(
+            self.outdir, needed, f"increment {inc.step} to {files} in {self.outdir}"))
         self.load_factors.append(float(inc.load_factor))
         t = float(pseudo_time(self.load_factors)[-1])
         if self.u is not None:
@@ -297,6 +350,56 @@ class ResultWriter:
         if self.interface_writer is not None:
             self.interface_writer.write(inc.load_factor, t)
         self._write_csv(inc, extra)
+
+
+@contextlib.contextmanager
+def _quiet_hdf5():
+    """Silence HDF5's automatic error printing (dozens of lines per failure, on every rank)
+    while DOLFINx writes: its failure is reported once, as an :class:`OutputWriteError`. The
+    library is the HDF5 loaded in this process (found in /proc/self/maps); where it cannot be
+    found, nothing changes."""
+    lib = _hdf5_library()
+    if lib is None:
+        yield
+        return
+    func, data = ctypes.c_void_p(), ctypes.c_void_p()
+    lib.H5Eget_auto2(ctypes.c_int64(0), ctypes.byref(func), ctypes.byref(data))  # H5E_DEFAULT
+    lib.H5Eset_auto2(ctypes.c_int64(0), None, None)
+    try:
+        yield
+    finally:
+        lib.H5Eset_auto2(ctypes.c_int64(0), func, data)
+
+
+_HDF5 = []
+
+
+def _hdf5_library():
+    if not _HDF5:
+        lib = None
+        try:
+            with open("/proc/self/maps") as f:
+                paths = {ln.split()[-1] for ln in f if "libhdf5" in ln and "_hl" not in ln}
+            for path in sorted(paths):
+                candidate = ctypes.CDLL(path)
+                if hasattr(candidate, "H5Eset_auto2") and hasattr(candidate, "H5Eget_auto2"):
+                    lib = candidate
+                    break
+        except OSError:
+            lib = None
+        _HDF5.append(lib)
+    return _HDF5[0]
+
+
+_UNCLOSED = []
+
+
+def _never_destroy(obj) -> None:
+    """Keep ``obj`` alive to the end of the process and past it: the C++ destructor of an
+    XDMFFile whose close failed tries to close again, throws, and terminates the process
+    (``std::terminate``) at exit, after the clear error."""
+    _UNCLOSED.append(obj)
+    ctypes.pythonapi.Py_IncRef(ctypes.py_object(obj))
 
 
 class CsvRecorder:
@@ -325,14 +428,19 @@ class CsvRecorder:
         self._flush()
 
     def _flush(self) -> None:
-        if self.path is None or self.comm.rank != 0:
+        """Rewrite the file on rank 0 (collective: a failure raises on every rank)."""
+        if self.path is None:
             return
-        os.makedirs(os.path.dirname(self.path) or ".", exist_ok=True)
-        text = io.StringIO(newline="")
-        w = csv.writer(text)
-        w.writerow(self.columns)
-        w.writerows([[f"{v:.12g}" for v in r] for r in self.rows])
-        atomic_write(self.path, text.getvalue())
+
+        def act():
+            os.makedirs(os.path.dirname(self.path) or ".", exist_ok=True)
+            text = io.StringIO(newline="")
+            w = csv.writer(text)
+            w.writerow(self.columns)
+            w.writerows([[f"{v:.12g}" for v in r] for r in self.rows])
+            atomic_write(self.path, text.getvalue())
+
+        run_on_root(self.comm, act)
 
     def array(self) -> np.ndarray:
         """(n_rows, n_columns) values."""

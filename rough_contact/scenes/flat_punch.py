@@ -31,6 +31,7 @@ from rough_contact.fem.boundary import fix
 from rough_contact.fem.compat import element_degree, vector_space
 from rough_contact.fem.contact import ContactInterface
 from rough_contact.fem.mesh import Scene
+from rough_contact.fem.pairing import AutoPairing
 from rough_contact.fem.problem import ContactProblem, Material, SurfaceLoad
 from rough_contact.interface.contract import InterfaceLawProtocol
 from rough_contact.io import ResultWriter, gather_points
@@ -222,8 +223,16 @@ def build(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2, load_h
           dof_threshold=None, quadrature_degree=None, normal=None, seating_steps=None,
           cell_type="tetrahedron", *, punch_scene=None, total_force=TOTAL_FORCE,
           solver_defaults=None, quadrature="gauss", solver_options=None, enforcement=None,
-          kt_over_kn=None):
+          kt_over_kn=None, pairing="auto"):
     """Mesh, law, interface, problem and solver of the quarter punch. Collective.
+
+    ``pairing`` pairs the punch bottom with the foundation (``ContactInterface(pairing=)``):
+    ``"auto"`` (default) is the conforming pairing when the two surfaces match facet to facet
+    (the scene of :func:`quarter_punch`), else the mortar, the non-matching pairing that
+    passes the patch test (docs/nonmatching.md); with ``quadrature="vertex"``, which the mortar
+    cannot use, surfaces that do not match are an error naming the choices. ``"conforming"``,
+    ``"projection"``, ``"mortar"`` or a :class:`~rough_contact.fem.pairing.Pairing` are used as
+    given (the projection fails the patch test on non-nested meshes).
 
     ``quadrature`` is the interface rule (``"gauss"`` of ``quadrature_degree``, default 2 x
     order, or ``"vertex"``: nodal, P1 only; see ``ContactInterface``).
@@ -271,9 +280,12 @@ def build(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2, load_h
 
     first, second = scene.contact_pair
     qdeg = quadrature_degree if quadrature_degree is not None else default_qdeg(order)
+    if isinstance(pairing, str) and pairing == "auto":   # non-matching: the patch-exact mortar
+        pairing = AutoPairing(second, "mortar" if quadrature == "gauss" else None)
     interface = ContactInterface(V, scene.facet_tags, first, second, law=interface_law,
                                  grain_direction=GRAIN_X, quadrature_degree=qdeg,
-                                 quadrature=quadrature, bcs=bcs, enforcement=enforcement)
+                                 quadrature=quadrature, bcs=bcs, enforcement=enforcement,
+                                 pairing=pairing)
     materials = {scene.tag("punch"): Material(E, NU), scene.tag("foundation"): Material(E, NU)}
     loads = [SurfaceLoad(scene.tag("load"), force=[0.0, 0.0, -quarter_force])]
     problem = ContactProblem(V, materials, bcs, loads, cell_tags=scene.cell_tags,

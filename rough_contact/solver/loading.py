@@ -21,8 +21,10 @@ every rank together. Any other exception (bad input, a programming error, a ``PE
 propagates at once with its type and traceback: no cutback, no LoadStepError.
 
 A failed step whose applied tangential force exceeds what friction can carry (mu_max of a
-``FrictionBoundedLaw`` times the applied normal force) raises :class:`FrictionCapacityError`
-(a ``LoadStepError``) at once instead of cutting back: the body slides (``friction_check``).
+``FrictionBoundedLaw`` times the normal force: the applied one, or the one the interface carried
+at the last converged increment if larger, as under a prescribed normal displacement) raises
+:class:`FrictionCapacityError` (a ``LoadStepError``) at once instead of cutting back: the body
+slides (``friction_check``).
 
 Guards before and after each solve:
 
@@ -126,7 +128,7 @@ class Increment:
         residuals: residual norm history of the Newton iterations [N].
         n_points: interface quadrature points (0 without interface).
         n_active: points in contact (p > 0).
-        n_slipping: points slipping.
+        n_slipping: points in contact that slip (the friction limit active).
         applied_force: total external force vector at this load factor (3,) [N].
         contact_force: total interface force on the FIRST body (3,) [N] (zeros if unknown).
         real_area: real contact area [mm^2] (nan if unknown).
@@ -254,9 +256,12 @@ def load_path(problem: ContactProblem, solver: SNESSolver, factors: Iterable[flo
 
         friction_check: when a step fails to converge and the law bounds friction
             (``FrictionBoundedLaw``), compare the tangential part of the applied surface force
-            (relative to the first surface's mean normal) with mu_max times its normal part;
-            if it is larger, raise :class:`FrictionCapacityError` instead of cutting back (the
-            body slides). Turn it off for a body that other supports hold tangentially.
+            (relative to the first surface's mean normal) with mu_max times the normal force:
+            the larger of the applied normal force and the normal force the interface carried
+            at the last converged increment (a normal load by prescribed displacement applies
+            no force but is carried); if it is larger, raise :class:`FrictionCapacityError`
+            instead of cutting back (the body slides). Turn it off for a body that other
+            supports hold tangentially.
         checkpoint: directory receiving a checkpoint after every converged increment
             (``rough_contact.solver.checkpoint``: atomic, two alternating slots). The
             checkpoint of an increment is written when the caller asks for the next one (after
@@ -317,6 +322,7 @@ class _Stepper:
         self.u_previous, self.lam_previous = None, None  # the converged state before u_committed
         self.step = 0
         self.spent = [0, 0, 0]  # Newton its, linear its, failed attempts since the last step
+        self.carried = None     # (3,) interface force of the last converged increment [N]
 
     def run(self, *, checkpoint, resume, outputs, max_steps) -> Iterator[Increment]:
         problem = self.problem
@@ -413,6 +419,7 @@ class _Stepper:
             inc.contact_force, inc.real_area = s.contact_force, s.real_area
             inc.dissipation = s.dissipation
             inc.n_beyond_validity = s.n_beyond_validity
+            self.carried = np.array(s.contact_force, dtype=float)
         saved = None
         if checkpoint is not None:   # written after the caller's loop body
             saved = CheckpointState(
@@ -443,7 +450,8 @@ class _Stepper:
             why = f"{result.reason_name} after {result.iterations} its"
         if self.friction_check and interface is not None and isinstance(interface.law,
                                                                         FrictionBoundedLaw):
-            _check_friction_capacity(interface, f_failed, lam, target, self.lam_committed, why)
+            _check_friction_capacity(interface, f_failed, self.carried, lam, target,
+                                     self.lam_committed, why)
         delta *= 0.5
         cutbacks += 1
         if abs(delta) < self.min_increment:
@@ -458,12 +466,17 @@ class _Stepper:
         return delta, cutbacks
 
 
-def _check_friction_capacity(interface, f, lam, target, lam_committed, why) -> None:
+def _check_friction_capacity(interface, f, carried, lam, target, lam_committed, why) -> None:
     """Raise FrictionCapacityError if the tangential part of the applied force ``f`` (3,) [N]
-    of the failed step exceeds mu_max times its normal part."""
+    of the failed step exceeds mu_max times the normal force: the larger of the applied one
+    (the normal part of ``f``) and the one the interface carried at the last converged increment
+    (``carried`` (3,) [N], None before the first one), so that a normal load applied by a
+    prescribed displacement (no applied normal force) counts too."""
     mu = float(interface.law.max_friction_coefficient())
     n = interface.mean_normal()
-    normal = abs(float(f @ n))
+    applied_normal = abs(float(f @ n))
+    carried_normal = 0.0 if carried is None else abs(float(carried @ n))
+    normal = max(applied_normal, carried_normal)
     tangential = float(np.linalg.norm(f - (f @ n) * n))
     capacity = mu * normal
     if tangential > capacity * (1.0 + 1e-9) + 1e-12 * max(tangential, normal):
@@ -475,7 +488,9 @@ def _check_friction_capacity(interface, f, lam, target, lam_committed, why) -> N
             f"{excess:.6g} N ({100 * excess / max(capacity, 1e-300):.3g} %): the body slides, no "
             "smaller increment reaches it. Lower the tangential load, raise the normal load, or "
             "drive the motion by a prescribed displacement; if other supports hold the body "
-            f"tangentially, pass friction_check=False. Last converged load factor "
+            f"tangentially, pass friction_check=False. The normal force is the larger of the "
+            f"applied one ({applied_normal:.6g} N) and the one the interface carried at the last "
+            f"converged increment ({carried_normal:.6g} N). Last converged load factor "
             f"{lam_committed:.6g} is committed", lam, lam_committed, tangential, capacity)
 
 

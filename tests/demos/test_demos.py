@@ -88,6 +88,88 @@ def test_demo_flat_punch_rejects_bad_options(tmp_path):
         assert words in proc.stderr, proc.stderr[-2000:]
 
 
+def _own_stderr(stderr: str) -> list:
+    """The program's lines of stderr: before the launcher's closing note (the dashed box that
+    Open MPI's mpirun 4 or prterun 5 adds when a process exits with a non-zero status),
+    without blank lines and the launcher's own "PMIX ERROR" lines."""
+    lines = stderr.splitlines()
+    for i, line in enumerate(lines[:-1]):
+        if set(line) == {"-"} and ("Primary job" in lines[i + 1]
+                                   or "exited with non-zero status" in lines[i + 1]):
+            lines = lines[:i]
+            break
+    return [ln for ln in lines if ln.strip() and "PMIX ERROR" not in ln]
+
+
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_demo_error_on_every_rank_ends_with_the_message(tmp_path, ranks):
+    """Issue 24, item 7: a bad input that every rank refuses (a negative element size, checked
+    by the library) ends the run with status 1, the message as the last line of the demo's
+    error output and of its standard output, once, and no MPI_ABORT banner after it."""
+    if ranks > 1 and MPIRUN is None:
+        pytest.skip("mpirun not found")
+    env = dict(os.environ, MPLBACKEND="Agg", OMPI_ALLOW_RUN_AS_ROOT="1",
+               OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OPENBLAS_NUM_THREADS="1")
+    cmd = [sys.executable, str(DEMOS / "demo_flat_punch.py"), "--mesh-size", "-1",
+           "--outdir", str(tmp_path / "out")]
+    if ranks > 1:
+        cmd = [MPIRUN, "-n", str(ranks)] + cmd
+    proc = subprocess.run(cmd, cwd=tmp_path, env=env, capture_output=True, text=True,
+                          timeout=300)
+    message = "ValueError: mesh_size = -1.0 mm is invalid: it must be finite and > 0"
+    assert proc.returncode != 0
+    assert "MPI_ABORT" not in proc.stderr, proc.stderr[-3000:]
+    assert proc.stderr.count(message) == 1, proc.stderr[-3000:]
+    assert _own_stderr(proc.stderr)[-1] == message, proc.stderr[-3000:]
+    if ranks > 1:
+        assert proc.stdout.strip().splitlines()[-1] == f"error: {message}"
+
+
+@pytest.mark.skipif(MPIRUN is None, reason="mpirun not found")
+def test_uncaught_exception_on_some_ranks_aborts(tmp_path):
+    """The other half of item 7: when only some ranks fail, the others would wait forever in
+    their next collective, so the job is still aborted (MPI_ABORT, after the message); when all
+    fail, it ends without the abort."""
+    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
+               PYTHONPATH=os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]))
+    worker = Path(__file__).with_name("failing_ranks.py")
+    runs = {mode: subprocess.run([MPIRUN, "-n", "2", sys.executable, str(worker), mode],
+                                 cwd=tmp_path, env=env, capture_output=True, text=True,
+                                 timeout=120) for mode in ("one", "all")}
+    one, every = runs["one"], runs["all"]
+    assert one.returncode != 0 and "MPI_ABORT" in one.stderr, one.stderr[-2000:]
+    assert "ValueError: steps = 0 is invalid (rank 1 of 2)" in one.stderr
+    assert every.returncode != 0 and "MPI_ABORT" not in every.stderr, every.stderr[-2000:]
+    own = _own_stderr(every.stderr)
+    assert own[-1] == "ValueError: steps = 0 is invalid (rank 0 of 2)", every.stderr[-2000:]
+    assert "rank 1: ValueError: steps = 0 is invalid (rank 1 of 2)" in every.stderr
+
+
+def _readme_snippet() -> str:
+    """The python block under "## What it does" in README.md."""
+    text = (ROOT / "README.md").read_text()
+    section = text[text.index("## What it does"):]
+    start = section.index("```python\n") + len("```python\n")
+    return section[start:section.index("```\n", start)]
+
+
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_readme_snippet(tmp_path, ranks):
+    """The README's script runs as it stands (serial and 2 ranks): one line per increment of
+    the load path 0.25 ... 1 ... 0.25, the contact force equal to the applied 250 N times the
+    load factor (the interface carries the whole load: force balance, 4 digits printed)."""
+    if ranks > 1 and MPIRUN is None:
+        pytest.skip("mpirun not found")
+    script = tmp_path / "readme_snippet.py"
+    script.write_text(_readme_snippet())
+    out = run([script], tmp_path, ranks)
+    rows = [ln.split() for ln in out.splitlines() if ln.startswith("load ")]
+    loads = [float(r[1].rstrip(":")) for r in rows]
+    assert loads == [0.25, 0.5, 0.75, 1.0, 0.75, 0.5, 0.25]
+    for lam, r in zip(loads, rows):
+        assert float(r[4]) == pytest.approx(250.0 * lam, abs=0.006), r
+
+
 def test_show_scene_mesh(tmp_path):
     out = run([DEMOS / "show_scene_mesh.py", "flat_punch", "--mesh-size", "40",
                "--contact-size", "10", "--xdmf", tmp_path / "punch.xdmf"], tmp_path)

@@ -74,6 +74,11 @@ def patch(cell_type, order, size_lower, size_upper, first, pairing, law, E_lower
     slipping = c.allreduce(int(pf.slipping[real].sum()), op=MPI.SUM)
     force = ci.contact_force()
     summary = ci.summary()
+    # issue 24, item 11: the header's count (n_points_global) is the increments' count, the
+    # points with weight; the mortar's slot-filling copies are counted apart (n_slots_global)
+    n_real = c.allreduce(int(real.sum()), op=MPI.SUM)
+    assert ci.n_points_global == summary.n_points == n_real
+    assert ci.n_slots_global == c.allreduce(ci.n_points, op=MPI.SUM) >= n_real
     facets = facet_output(ci)          # what the XDMF writer writes per facet
     f_err = c.allreduce(float(np.max(np.abs(facets.pressure - p), initial=0.0)), op=MPI.MAX)
     assert f_err <= 1e-8 * p
@@ -347,3 +352,27 @@ def test_two_xdmf_files_make_one_scene(tmp_path, order):
     with pytest.raises(ValueError, match="does not exist"):
         scene_from_xdmf_files([(f"{folder}/none.xdmf", {})], comm, contact_pair=("a", "b"))
 
+
+
+@pytest.mark.parametrize("pairing", ["projection", "auto"])
+def test_larger_first_surface_says_swap(pairing):
+    """Issue 24, item 12: a slab 3 mm long given as the first surface and a slider 1 mm long
+    as the second: the slab's points beyond the slider's edge have no partner and no search
+    radius gives them one. The error says which surface is larger and to swap them, as the
+    mortar's does, instead of "raise search_radius"; with the surfaces swapped it pairs."""
+    from rough_contact.scenes.meshes.blocks import slider_on_slab
+
+    scene = slider_on_slab(size_slab=0.25, size_slider=0.2)
+    V = compat.vector_space(scene.mesh, 1)
+    slider, slab = scene.contact_pair
+    with pytest.raises(ValueError) as err:
+        ContactInterface(V, scene.facet_tags, slab, slider, law=LinearPenalty(1.0),
+                         pairing=pairing, search_radius=10.0)
+    msg = str(err.value)
+    assert f"Surface {slab} (1.5 mm^2) is larger than surface {slider} (0.5 mm^2)" in msg
+    assert "swap first_tag and second_tag" in msg and "raise search_radius" not in msg
+    assert ("pairing = 'auto'" in msg) == (pairing == "auto")
+    ci = ContactInterface(V, scene.facet_tags, slider, slab, law=LinearPenalty(1.0),
+                          pairing=pairing)
+    assert ci.pairing_used == "projection"
+    assert abs(ci.nominal_area() - 0.5) <= 1e-12

@@ -262,3 +262,31 @@ def test_augmented_extrapolate():
     np.testing.assert_allclose(AugmentedLagrangian.extrapolate(now, prev, 1.0)[1],
                                [0.0, 0.0, 0.0])
     assert now[0, 0] == 2.0
+
+
+def test_softplus_counts_slip_only_in_contact():
+    """Issue 24, item 8: a point out of contact (p = 0: the softplus underflows 745 smoothing
+    lengths away) with a tangential jump is open, not slipping. Coulomb's cone at p = 0 is the
+    point t_T = 0: the traction vanishes there and the plastic slip follows the jump, but the
+    point carries no friction, so it must not be counted as slipping. Points in contact past
+    the cone slip; the slip count never exceeds the contact count (also with multipliers)."""
+    law = SoftplusPenalty(k_normal=1e4, width=1e-4, k_tangential=1e4, friction=0.3)
+    jump = np.array([[1.0, 2e-3, -1e-3],       # far open, sheared: p = 0 exactly
+                     [1.0, 0.0, 0.0],          # far open, no shear
+                     [-1e-2, 5e-2, 0.0],       # in contact, |tau| = 500 > mu p = 30: slips
+                     [-1e-2, 1e-4, 0.0]])      # in contact, |tau| = 1 < 30: sticks
+    committed = InterfaceState.zeros(4)
+    for multipliers in (None, np.zeros((4, 3))):
+        res = law.evaluate(jump, committed, multipliers)
+        check_contract(res, 4)
+        assert res.pressure[0] == 0.0 and res.pressure[1] == 0.0
+        np.testing.assert_array_equal(res.contact, [False, False, True, True])
+        np.testing.assert_array_equal(res.slipping, [False, False, True, False])
+        np.testing.assert_array_equal(res.traction[0], 0.0)          # the cone at p = 0
+        np.testing.assert_allclose(res.state.plastic_slip[0], jump[0, 1:], rtol=1e-12)
+        assert res.dissipation[0] == 0.0
+    rng = np.random.default_rng(4)
+    many = np.column_stack([rng.uniform(-2e-3, 2e-1, 500), rng.normal(0, 3e-4, (500, 2))])
+    res = law.evaluate(many, InterfaceState.zeros(500))
+    assert not np.any(res.slipping & ~res.contact)
+    assert 0 < res.slipping.sum() < res.contact.sum() < 500

@@ -23,7 +23,20 @@ from rough_contact.fem.pairing.facets import GatheredSurface, cmap_element, face
 from rough_contact.fem.pairing.geometry import project_points, tabulate
 from rough_contact.validation import check_scalar
 
-__all__ = ["ProjectionPairing", "SlidingProjectionPairing"]
+__all__ = ["ProjectionPairing", "SlidingProjectionPairing", "facet_areas"]
+
+
+def facet_areas(vertex_x: np.ndarray) -> np.ndarray:
+    """(n,) areas of the flat facets spanned by their vertices (n, 3 or 4, 3) in reference
+    order (quadrilaterals numbered tensor-wise: 0, 1, 3, 2 around) [mm^2]: half the norm of the
+    cross product of the two diagonals (of two edges for a triangle)."""
+    if vertex_x.shape[0] == 0:
+        return np.zeros(0)
+    if vertex_x.shape[1] == 3:
+        d1, d2 = vertex_x[:, 1] - vertex_x[:, 0], vertex_x[:, 2] - vertex_x[:, 0]
+    else:
+        d1, d2 = vertex_x[:, 3] - vertex_x[:, 0], vertex_x[:, 2] - vertex_x[:, 1]
+    return 0.5 * np.linalg.norm(np.cross(d1, d2), axis=1)
 
 
 class ProjectionPairing:
@@ -116,12 +129,28 @@ class ProjectionPairing:
             found = (f"the nearest partner found along the normal of such a point is "
                      f"{nearest:.6g} mm away" if np.isfinite(nearest) else
                      "no facet of the second surface lies on their normals")
+            # points whose normal meets no facet at all: beyond the second surface's edge,
+            # where no search radius helps (a larger first surface)
+            n_off = comm.allreduce(int((missing & ~np.isfinite(proj.nearest)).sum()),
+                                   op=MPI.SUM)
+            area1 = comm.allreduce(float(facet_areas(self._ctx.geo1.vertex_x).sum()),
+                                   op=MPI.SUM)
+            area2 = float(facet_areas(self._second.vertex_x).sum())   # gathered: global
+            if n_off and area1 > area2 * (1.0 + 1e-9):
+                advice = (
+                    f"Surface {first_tag} ({area1:.6g} mm^2) is larger than surface "
+                    f"{second_tag} ({area2:.6g} mm^2): {n_off} of these points lie beyond the "
+                    f"edge of surface {second_tag}, where no search radius finds a partner. "
+                    "Make the smaller surface the first contact surface (swap first_tag and "
+                    "second_tag): every point of the first surface needs a partner")
+            else:
+                advice = ("Check that the surfaces overlap and face each other, or raise "
+                          "search_radius")
             raise ValueError(
                 f"{after}{n_missing} of {n_total} quadrature points of contact surface "
                 f"{first_tag} have no partner on surface {second_tag} within the search "
                 f"radius {search_radius:.6g} mm along their normal; {why}{found}; first "
-                f"points: {first}. Check that the surfaces overlap and face each other, or "
-                "raise search_radius")
+                f"points: {first}. {advice}")
 
 
 class SlidingProjectionPairing(ProjectionPairing):
