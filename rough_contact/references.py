@@ -41,7 +41,8 @@ from rough_contact.validation import check_scalar
 
 __all__ = ["effective_modulus", "hertz_force", "hertz_radius", "hertz_peak_pressure",
            "hertz_pressure", "stick_ratio", "sliding_approach", "tangential_approach",
-           "energy_per_cycle", "energy_per_cycle_small", "fretting_cycle"]
+           "energy_per_cycle", "energy_per_cycle_small", "fretting_cycle",
+           "fretting_energy_ratio"]
 
 
 # ## Hertz
@@ -153,3 +154,10 @@ def fretting_cycle(delta_amplitude, mu: float, P: float, a: float, G: float, nu:
     box = 4.0 * Q * d
     A = np.where(box > 0, W / np.where(box > 0, box, 1.0), 0.0)
     return Q, W, A
+
+
+def fretting_energy_ratio(delta_ratio):
+    """Mindlin–Deresiewicz energy ratio A as a function of delta* / delta_t alone (A does not
+    depend on mu, P, a, G, nu otherwise): :func:`fretting_cycle` with delta_t = 1 [-]."""
+    # unit contact: mu = P = a = 1, nu = 0, G = 3 (2 - 0) / 16 makes sliding_approach = 1
+    return fretting_cycle(delta_ratio, 1.0, 1.0, 1.0, 3.0 * 2.0 / 16.0, 0.0)[2]

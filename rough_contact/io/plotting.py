@@ -432,7 +432,8 @@ def plot_fretting_map(amplitude, energy_ratio, slip_fraction, *, references: Opt
         amplitude: (n,) displacement amplitudes, > 0 (unit in ``xlabel``).
         energy_ratio: (n,) A [-].
         slip_fraction: (n,) slipping area / contact area in [0, 1] [-].
-        references: {label: (amplitude (m,), A (m,))} curves drawn on the A panel.
+        references: {label: (amplitude (m,), A (m,)[, fmt])} drawn on the A panel (dashed,
+            or in the matplotlib format ``fmt``, e.g. ``"x"`` for values at the amplitudes).
         transition: amplitude of the partial-to-gross slip transition (a vertical line), or None.
         xlabel, title, path, figsize, dpi: as :func:`plot_load_displacement`.
 
@@ -453,9 +454,9 @@ def plot_fretting_map(amplitude, energy_ratio, slip_fraction, *, references: Opt
     FigureCanvasAgg(fig)
     ax0, ax1 = fig.subplots(1, 2)
     ax0.semilogx(a, ratio, "o-", color="C0", label="computed")
-    for name, (x, y) in (references or {}).items():
+    for name, (x, y, *fmt) in (references or {}).items():
         ax0.semilogx(np.asarray(x, dtype=float), _values(y, len(x), f"reference {name!r}"),
-                     "--", lw=1.0, label=name)
+                     fmt[0] if fmt else "--", lw=1.0, label=name)
     ax0.set_ylabel("energy ratio $A = E_d / (4 F^* \\delta^*)$ [-]")
     ax0.set_ylim(-0.02, 1.02)
     ax1.semilogx(a, 100.0 * slip, "s-", color="C3")
@@ -464,13 +465,16 @@ def plot_fretting_map(amplitude, energy_ratio, slip_fraction, *, references: Opt
     for ax in (ax0, ax1):
         if transition is not None:
             ax.axvline(transition, color="0.4", lw=0.8, ls=":")
-            ax.text(transition, 0.98, " gross slip ->", transform=ax.get_xaxis_transform(),
-                    fontsize=7, va="top", color="0.3")
-            ax.text(transition, 0.90, "<- partial slip ", transform=ax.get_xaxis_transform(),
+            ax.text(transition, 0.50, " gross slip ->", transform=ax.get_xaxis_transform(),
+                    fontsize=7, va="bottom", color="0.3")
+            ax.text(transition, 0.44, "<- partial slip ", transform=ax.get_xaxis_transform(),
                     fontsize=7, va="top", ha="right", color="0.3")
         ax.set_xlabel(xlabel)
         ax.grid(True, which="both", lw=0.3)
-    ax0.legend(frameon=False, fontsize=7, loc="center left")
+        ax.set_xticks(a)                       # the amplitudes run, in plain numbers
+        ax.set_xticklabels([f"{v:g}" for v in a], rotation=60, fontsize=8)
+        ax.minorticks_off()
+    ax0.legend(frameon=False, fontsize=7, loc="lower right")
     if title:
         fig.suptitle(title, fontsize=10)
     return _finish(fig, path, dpi)

@@ -149,3 +149,7 @@ def test_fretting_energy_ratio_limits():
     assert np.all(np.diff(a_of_x) > 0)
     with pytest.raises(ValueError, match="delta_amplitude = -1"):
         ref.fretting_cycle(-1.0, MU, P, A, G, NU)
+    # the dimensionless form used by the fretting map
+    x = np.array([0.2, 1.0, 2.5])
+    np.testing.assert_allclose(ref.fretting_energy_ratio(x),
+                               ref.fretting_cycle(x * K, MU, P, A, G, NU)[2], rtol=1e-12)
