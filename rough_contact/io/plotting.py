@@ -442,7 +442,8 @@ def plot_fretting_map(amplitude, energy_ratio, slip_fraction, *, references: Opt
     """
     a = np.asarray(amplitude, dtype=float)
     if a.ndim != 1 or a.size == 0 or not np.all(np.isfinite(a) & (a > 0)):
-        raise ValueError(f"amplitude {a.tolist()} must be a non-empty 1D array of finite values > 0")
+        raise ValueError(f"amplitude {a.tolist()} must be a non-empty 1D array of finite "
+                         "values > 0")
     ratio = _values(energy_ratio, len(a), "energy_ratio")
     slip = _values(slip_fraction, len(a), "slip_fraction")
     if np.any((slip < 0) | (slip > 1 + 1e-12)):
