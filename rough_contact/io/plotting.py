@@ -475,7 +475,7 @@ def plot_fretting_map(amplitude, energy_ratio, slip_fraction, *, references: Opt
         ax.set_xticks(a)                       # the amplitudes run, in plain numbers
         ax.set_xticklabels([f"{v:g}" for v in a], rotation=60, fontsize=8)
         ax.minorticks_off()
-    ax0.legend(frameon=False, fontsize=7, loc="lower right")
+    ax0.legend(frameon=False, fontsize=7, loc="upper left")
     if title:
         fig.suptitle(title, fontsize=10)
     return _finish(fig, path, dpi)
