@@ -22,6 +22,13 @@ parameter (1 - 2 nu) / (2 (1 - nu)) vanishes):
   q* = Q* / (mu P); for small q* it tends to (2 - nu) Q*^3 / (36 G a mu P) (cubic in the
   amplitude). ``tests/unit/test_mindlin_closed_forms.py`` checks W against the numerical loop
   area of the Masing branches and the cubic limit against the series.
+* fretting under an imposed displacement amplitude delta* (:func:`fretting_cycle`): partial
+  slip while delta* < delta_t = K (the sliding approach), with Q* from delta(Q*) = delta* and
+  the energy W above; gross slip beyond, Q* = mu P and the loop of the transition stretched by
+  sliding plateaus, W = W(mu P) + 4 mu P (delta* - delta_t) = 4 mu P (delta* - 0.8 delta_t).
+  The energy ratio A = W / (4 Q* delta*) rises from 0 (A ~ delta* / (12 delta_t) for small
+  amplitudes) to 0.2 at the transition (Fouvry's A_t = 0.2 of a sphere on a flat) and to
+  1 - 0.8 delta_t / delta* in gross slip.
 
 Units: mm, N, MPa.
 """
@@ -34,7 +41,8 @@ from rough_contact.validation import check_scalar
 
 __all__ = ["effective_modulus", "hertz_force", "hertz_radius", "hertz_peak_pressure",
            "hertz_pressure", "stick_ratio", "sliding_approach", "tangential_approach",
-           "energy_per_cycle", "energy_per_cycle_small"]
+           "energy_per_cycle", "energy_per_cycle_small", "fretting_cycle",
+           "fretting_energy_ratio"]
 
 
 # ## Hertz
@@ -113,3 +121,43 @@ def energy_per_cycle_small(Q_amplitude, mu: float, P: float, a: float, G: float,
     """The small-amplitude limit (2 - nu) Q*^3 / (36 G a mu P) [N mm]."""
     _q(Q_amplitude, mu, P)
     return (2.0 - nu) * np.abs(Q_amplitude) ** 3 / (36.0 * G * a * mu * P)
+
+
+def fretting_cycle(delta_amplitude, mu: float, P: float, a: float, G: float, nu: float):
+    """Mindlin–Deresiewicz fretting under an imposed tangential displacement amplitude delta*.
+
+    Partial slip (delta* < delta_t = :func:`sliding_approach`): Q* solves delta(Q*) = delta*,
+    Q* = mu P [1 - (1 - delta* / delta_t)^(3/2)], and the energy is :func:`energy_per_cycle`.
+    Gross slip (delta* >= delta_t): Q* = mu P and the loop is the transition loop with sliding
+    plateaus of length 2 (delta* - delta_t) at +-mu P: W = W(mu P) + 4 mu P (delta* - delta_t).
+
+    Args:
+        delta_amplitude: delta* >= 0 [mm] (scalar or array).
+        mu, P, a, G, nu: friction coefficient, normal force [N], Hertz contact radius [mm],
+            shear modulus [MPa], Poisson's ratio, as in :func:`tangential_approach`.
+
+    Returns:
+        ``(Q_amplitude, energy, ratio)``: Q* [N], W [N mm] and A = W / (4 Q* delta*) [-]
+        (0 at delta* = 0).
+    """
+    d = np.asarray(delta_amplitude, dtype=float)
+    if not np.all(np.isfinite(d) & (d >= 0.0)):
+        raise ValueError(f"delta_amplitude = {np.min(d):.6g} mm is invalid: it must be finite "
+                         "and >= 0")
+    check_scalar("P", P, lo=0.0, unit="N")
+    check_scalar("a", a, lo=0.0, unit="mm")
+    check_scalar("G", G, lo=0.0, unit="MPa")
+    dt = sliding_approach(mu, P, a, G, nu)
+    x = np.minimum(d / dt, 1.0)
+    Q = mu * P * (1.0 - (1.0 - x) ** 1.5)
+    W = energy_per_cycle(Q, mu, P, a, G, nu) + 4.0 * mu * P * np.maximum(d - dt, 0.0)
+    box = 4.0 * Q * d
+    A = np.where(box > 0, W / np.where(box > 0, box, 1.0), 0.0)
+    return Q, W, A
+
+
+def fretting_energy_ratio(delta_ratio):
+    """Mindlin–Deresiewicz energy ratio A as a function of delta* / delta_t alone (A does not
+    depend on mu, P, a, G, nu otherwise): :func:`fretting_cycle` with delta_t = 1 [-]."""
+    # unit contact: mu = P = a = 1, nu = 0, G = 3 (2 - 0) / 16 makes sliding_approach = 1
+    return fretting_cycle(delta_ratio, 1.0, 1.0, 1.0, 3.0 * 2.0 / 16.0, 0.0)[2]

@@ -19,7 +19,8 @@ the plane of a flat interface).
 * :func:`plot_load_displacement`: one or more load-displacement curves.
 * :func:`plot_hysteresis`: force-displacement loops with the energy of every cycle,
   :func:`loop_energies` (the closed-path integral of F du), cycles split by
-  :func:`split_cycles`.
+  :func:`split_cycles` or given by the load program.
+* :func:`plot_fretting_map`: energy ratio and slipping area share against the amplitude.
 """
 
 from __future__ import annotations
@@ -31,8 +32,8 @@ import numpy as np
 from rough_contact.cycles import loop_energies
 
 __all__ = ["STATUS_COLORS", "plot_facet_field", "plot_pressure_map", "plot_status_map",
-           "plot_slip_quiver", "plot_load_displacement", "plot_hysteresis", "loop_energies",
-           "split_cycles"]
+           "plot_slip_quiver", "plot_load_displacement", "plot_hysteresis", "plot_fretting_map",
+           "loop_energies", "split_cycles"]
 
 STATUS_LABELS = ("open", "stick", "slip")
 STATUS_COLORS = ("#d9d9d9", "#3b6fb6", "#d6452b")  # grey, blue, red
@@ -363,17 +364,25 @@ def split_cycles(displacement: Sequence[float]) -> np.ndarray:
     return np.unique(np.r_[0, minima, len(u) - 1])
 
 
-def plot_hysteresis(displacement, force, *, boundaries=None, energy_unit: str = "N mm",
-                    xlabel: str = "displacement [mm]", ylabel: str = "force [N]",
-                    title: str = "", ax: Any = None, path: Optional[str] = None,
-                    figsize=(6.0, 4.5), dpi: int = 150):
+def plot_hysteresis(displacement, force, *, boundaries=None, cycles: Optional[Sequence[int]] = None,
+                    energy_unit: str = "N mm", xlabel: str = "displacement [mm]",
+                    ylabel: str = "force [N]", title: str = "", ax: Any = None,
+                    path: Optional[str] = None, figsize=(6.0, 4.5), dpi: int = 150):
     """Force-displacement hysteresis loops, one colour per cycle, the energy of each cycle
     (:func:`loop_energies`) in the legend.
+
+    Pass the cycles of the load program that made the path (``boundaries``, e.g.
+    ``rough_contact.solver.program.cycle_boundaries``): a cycle that starts at zero
+    displacement (0 -> +a -> -a -> 0) is one closed loop there, while :func:`split_cycles`
+    cuts it at the minima into open pieces. A piece whose ends differ is drawn dashed, labelled
+    "open path" and given no loop energy (its integral of F du is no loop area).
 
     Args:
         displacement: (n,) [mm].
         force: (n,) [N].
-        boundaries: cycle boundaries (indices); default :func:`split_cycles`.
+        boundaries: cycle boundaries (indices), cycle k spanning ``[b[k - 1], b[k]]``; default
+            :func:`split_cycles`.
+        cycles: the cycles to draw (1-based numbers of the boundaries' cycles); default all.
         energy_unit: unit of F du for the legend.
         xlabel, ylabel, title, ax, path, figsize, dpi: as :func:`plot_load_displacement`.
 
@@ -384,11 +393,21 @@ def plot_hysteresis(displacement, force, *, boundaries=None, energy_unit: str = 
     f = _values(force, len(u), "force")
     b = split_cycles(u) if boundaries is None else np.asarray(boundaries)
     energies = loop_energies(u, f, b)
+    n = len(energies)
+    chosen = range(1, n + 1) if cycles is None else [int(k) for k in cycles]
+    bad = [k for k in chosen if not 1 <= k <= n]
+    if bad or not chosen:
+        raise ValueError(f"cycles {list(chosen)} are invalid: the path has cycles 1 .. {n}")
+    closed_tol = 1e-9 * max(float(np.ptp(u)), 1e-300)
     fig, ax = _new_figure(ax, figsize)
-    for k, e in enumerate(energies):
-        seg = slice(b[k], b[k + 1] + 1)
-        ax.plot(u[seg], f[seg], marker="o", ms=2.5, lw=1.2,
-                label=f"cycle {k + 1}: $\\oint F\\,du$ = {e:.4g} {energy_unit}")
+    for k in chosen:
+        seg = slice(b[k - 1], b[k] + 1)
+        if abs(u[b[k]] - u[b[k - 1]]) <= closed_tol:
+            ax.plot(u[seg], f[seg], marker="o", ms=2.5, lw=1.2,
+                    label=f"cycle {k}: $\\oint F\\,du$ = {energies[k - 1]:.4g} {energy_unit}")
+        else:
+            ax.plot(u[seg], f[seg], ls="--", color="0.55", marker="o", ms=2.0, lw=1.0,
+                    label=f"part {k}: open path (not a loop)")
     ax.axhline(0.0, color="0.6", lw=0.5)
     ax.axvline(0.0, color="0.6", lw=0.5)
     ax.set_xlabel(xlabel)
@@ -397,4 +416,66 @@ def plot_hysteresis(displacement, force, *, boundaries=None, energy_unit: str = 
     ax.legend(frameon=False, fontsize=8)
     if title:
         ax.set_title(title, fontsize=10)
+    return _finish(fig, path, dpi)
+
+
+def plot_fretting_map(amplitude, energy_ratio, slip_fraction, *, references: Optional[Mapping[
+                      str, tuple]] = None, transition: Optional[float] = None,
+                      xlabel: str = "displacement amplitude $\\delta^*$ [um]",
+                      title: str = "", path: Optional[str] = None, figsize=(10.0, 4.2),
+                      dpi: int = 150):
+    """A fretting-map view of an amplitude sweep: the energy ratio A = E_d / (4 F* delta*) and
+    the slipping share of the contact area against the displacement amplitude (log axis), with
+    the partial-to-gross slip transition marked.
+
+    Args:
+        amplitude: (n,) displacement amplitudes, > 0 (unit in ``xlabel``).
+        energy_ratio: (n,) A [-].
+        slip_fraction: (n,) slipping area / contact area in [0, 1] [-].
+        references: {label: (amplitude (m,), A (m,)[, fmt])} drawn on the A panel (dashed,
+            or in the matplotlib format ``fmt``, e.g. ``"x"`` for values at the amplitudes).
+        transition: amplitude of the partial-to-gross slip transition (a vertical line), or None.
+        xlabel, title, path, figsize, dpi: as :func:`plot_load_displacement`.
+
+    Returns:
+        The figure (two axes).
+    """
+    a = np.asarray(amplitude, dtype=float)
+    if a.ndim != 1 or a.size == 0 or not np.all(np.isfinite(a) & (a > 0)):
+        raise ValueError(f"amplitude {a.tolist()} must be a non-empty 1D array of finite "
+                         "values > 0")
+    ratio = _values(energy_ratio, len(a), "energy_ratio")
+    slip = _values(slip_fraction, len(a), "slip_fraction")
+    if np.any((slip < 0) | (slip > 1 + 1e-12)):
+        raise ValueError(f"slip_fraction {slip.tolist()} must lie in [0, 1]")
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=figsize)
+    FigureCanvasAgg(fig)
+    ax0, ax1 = fig.subplots(1, 2)
+    ax0.semilogx(a, ratio, "o-", color="C0", label="computed")
+    for name, (x, y, *fmt) in (references or {}).items():
+        ax0.semilogx(np.asarray(x, dtype=float), _values(y, len(x), f"reference {name!r}"),
+                     fmt[0] if fmt else "--", lw=1.0, label=name)
+    ax0.set_ylabel("energy ratio $A = E_d / (4 F^* \\delta^*)$ [-]")
+    ax0.set_ylim(-0.02, 1.02)
+    ax1.semilogx(a, 100.0 * slip, "s-", color="C3")
+    ax1.set_ylabel("slipping share of the contact area [%]")
+    ax1.set_ylim(-2, 102)
+    for ax in (ax0, ax1):
+        if transition is not None:
+            ax.axvline(transition, color="0.4", lw=0.8, ls=":")
+            ax.text(transition, 0.50, " gross slip ->", transform=ax.get_xaxis_transform(),
+                    fontsize=7, va="bottom", color="0.3")
+            ax.text(transition, 0.44, "<- partial slip ", transform=ax.get_xaxis_transform(),
+                    fontsize=7, va="top", ha="right", color="0.3")
+        ax.set_xlabel(xlabel)
+        ax.grid(True, which="both", lw=0.3)
+        ax.set_xticks(a)                       # the amplitudes run, in plain numbers
+        ax.set_xticklabels([f"{v:g}" for v in a], rotation=60, fontsize=8)
+        ax.minorticks_off()
+    ax0.legend(frameon=False, fontsize=7, loc="upper left")
+    if title:
+        fig.suptitle(title, fontsize=10)
     return _finish(fig, path, dpi)

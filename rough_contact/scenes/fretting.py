@@ -4,14 +4,28 @@ Two blocks (lx x ly x h each, P1 or P2 tetrahedra) touch on z = 0 through the pa
 interface (spectral moments of section 9.2, orthotropic slip-hardening friction of case (b):
 mu rising from 0.25 to 0.5 with the accumulated slip, kT = 0.7 kN). The lower block is clamped
 at its bottom; the upper block's top carries the preload P (channel ``preload``) and is driven
-in x by u_x = a w(t) (channel ``cyclic``, triangle wave), u_y, u_z free. Per amplitude a, the
-run reports every increment (u_x, the reaction F_x, the dissipation) and per cycle the loop
-energy, the interface dissipation and the secant stiffness (``rough_contact.solver.program``).
+in x by u_x = delta* w(t) (channel ``cyclic``; w a sine by default, as a fretting rig drives it,
+or a triangle wave), u_y, u_z free. delta* is the displacement amplitude of the top, away from
+the contact, as a fretting rig measures it (bulk compliance included).
 
-Expected shape (Mindlin–Deresiewicz for a smooth contact; here the rough interface): at small
-amplitude only the edges micro-slip and the energy per cycle grows like a^3 (slope 3 on log-log);
-at large amplitude the joint slides and the energy grows like a (slope 1); slip hardening makes
-the first cycles dissipate more than the later ones (shakedown).
+Per amplitude the run records every increment (u_x, the reaction F_x, the dissipation, the
+slipping share of the contact area), prints one line per cycle (rank 0, flushed), writes the
+interface fields per increment (``interface.xdmf``) and summarises every cycle of the program
+(its cycle boundaries, ``rough_contact.solver.program.cycle_boundaries``): the loop energy E_d,
+the amplitudes F* and delta*, the energy ratio A = E_d / (4 F* delta*) and the largest slipping
+share. The last cycle of each amplitude is what a fretting study reports (:class:`CycleReport`):
+the regime is "stick" when no point slips, "partial slip" while a stuck part of the contact
+remains at the extremes, "gross slip" when the whole contact area slips.
+
+Expected shape: nothing slips below the micro-slip onset (A = 0, an elastic line); slip spreads
+from the edges of the joint (partial slip, A small) until the whole interface slips (gross
+slip); beyond it the loop tends to the parallelogram of an elastic joint in series with a
+sliding one, A -> 1 - F* / (k delta*) (k the joint's stick stiffness), and to 1 for
+delta* >> F* / k. A Hertzian (sphere-on-flat) contact reaches gross slip at A = 0.2
+(Mindlin–Deresiewicz, ``rough_contact.references.fretting_cycle``); the flat joint's nearly
+uniform shear makes its slip zone sweep the interface over a narrow range of amplitudes, at a
+smaller A (docs/loading.md). Slip hardening makes the first cycles dissipate more than the
+later ones (shakedown).
 
 Units: mm, N, MPa (amplitudes given in um at the API).
 """
@@ -19,6 +33,7 @@ Units: mm, N, MPa (amplitudes given in um at the API).
 from __future__ import annotations
 
 import csv
+import io
 import os
 from dataclasses import dataclass
 
@@ -29,23 +44,79 @@ from petsc4py import PETSc
 from rough_contact.fem.compat import vector_space
 from rough_contact.fem.problem import Material
 from rough_contact.io import CsvRecorder
+from rough_contact.io.files import atomic_write_text
+from rough_contact.io.interface_output import InterfaceWriter
 from rough_contact.scenes import flat_punch
 from rough_contact.scenes.defaults import quadrature_degree
 from rough_contact.scenes.setup import clamped_pair, preload_then_drive
 from rough_contact.scenes.meshes.blocks import two_blocks
 from rough_contact.solver.checkpoint import has_checkpoint
 from rough_contact.solver.loading import load_path
-from rough_contact.solver.program import cycle_summary, preload_then_cyclic
+from rough_contact.solver.program import cycle_boundaries, cycle_summary, preload_then_cyclic
 from rough_contact.solver.snes import SNESSolver
 from rough_contact.validation import check_scalar
 
-__all__ = ["FrettingRun", "PreloadStiffness", "run_amplitude", "run"]
+__all__ = ["FrettingRun", "CycleReport", "PreloadStiffness", "run_amplitude", "run",
+           "REPORT_COLUMNS"]
 
 
 _SCENES: dict = {}   # meshes built by run_amplitude, per parameters and communicator
 
 LOOP_COLUMNS = ("pseudo_time", "u_x_mm", "F_x_N", "F_z_contact_N", "dissipation_Nmm",
-                "n_slipping", "n_points", "newton_its_spent")
+                "n_slipping", "n_points", "newton_its_spent", "slip_area_fraction")
+
+REPORT_COLUMNS = ("amplitude_um", "cycle", "delta_um", "force_amplitude_N", "energy_Nmm",
+                  "interface_dissipation_Nmm", "energy_ratio", "slip_fraction", "regime",
+                  "slipping_increments")
+"""Columns of ``fretting_map.csv``: one row per amplitude, its last cycle (:class:`CycleReport`)."""
+
+GROSS_SLIP = 1.0 - 1e-9   # slipping share of the contact area from which no stuck part is left
+
+
+@dataclass(frozen=True)
+class CycleReport:
+    """What a fretting study reports of one cycle (normally the last, the steadiest).
+
+    Attributes:
+        amplitude_um: prescribed displacement amplitude [um].
+        cycle: the program's cycle number (1-based).
+        delta_um: delta*, half the peak-to-peak u_x of the cycle [um].
+        force_amplitude: F*, half the peak-to-peak F_x of the cycle [N].
+        energy: E_d, the loop area (trapezoidal integral of F_x du_x over the cycle) [N mm].
+        dissipated: the interface's own dissipation over the cycle [N mm] (equal to E_d in a
+            steady cycle).
+        energy_ratio: A = E_d / (4 F* delta*) [-].
+        slip_fraction: largest slipping share of the contact area over the cycle's increments
+            (slipping area / area in contact) [-].
+        regime: "stick" (nothing slips), "partial slip", "gross slip" (the whole contact area
+            slips at some instant of the cycle: ``slip_fraction >= GROSS_SLIP``).
+        slipping_increments: increments of the cycle with slipping points (how finely the
+            slipping part of the loop is resolved).
+    """
+
+    amplitude_um: float
+    cycle: int
+    delta_um: float
+    force_amplitude: float
+    energy: float
+    dissipated: float
+    energy_ratio: float
+    slip_fraction: float
+    regime: str
+    slipping_increments: int
+
+    def row(self) -> tuple:
+        """The values in the order of ``REPORT_COLUMNS``."""
+        return (self.amplitude_um, self.cycle, self.delta_um, self.force_amplitude, self.energy,
+                self.dissipated, self.energy_ratio, self.slip_fraction, self.regime,
+                self.slipping_increments)
+
+
+def regime(slip_fraction: float) -> str:
+    """"stick", "partial slip" or "gross slip" from the largest slipping share of the contact
+    area over a cycle."""
+    f = check_scalar("slip_fraction", slip_fraction, lo=0.0, lo_open=False, hi=1.0 + 1e-12)
+    return "stick" if f == 0.0 else "gross slip" if f >= GROSS_SLIP else "partial slip"
 
 
 @dataclass(frozen=True)
@@ -64,14 +135,21 @@ class FrettingRun:
         dissipation: cumulative interface dissipation [N mm].
         slipping: slipping interface points (int).
         n_points: interface points (int).
+        slip_fraction: slipping area / area in contact [-].
         newton: Newton iterations spent (all increments).
+        boundaries: the program's complete cycles among the increments
+            (``rough_contact.solver.program.cycle_boundaries``): cycle k spans the increments
+            ``boundaries[k - 1] .. boundaries[k]``.
         cycles: per cycle (``rough_contact.solver.program.cycle_summary``): cycle, loop_energy
-            [N mm], dissipated [N mm], secant_stiffness [N/mm].
+            [N mm], dissipated [N mm], delta_amplitude [mm], force_amplitude [N],
+            energy_ratio [-], secant_stiffness [N/mm], start, end.
         normal: the tabulated normal law (to reuse for other amplitudes).
         solved: increments solved by this call.
         k_normal, k_tangential: interface normal and tangential stiffness at the end of the
             preload, int dp/dg dA and int dt_x/ds_x dA [N/mm] (a restart past the preload
             reports the checkpointed run's values; NaN only when the preload was not reached).
+        steps_per_cycle: increments per cycle of the program.
+        wall_time: seconds spent in this call.
     """
 
     amplitude_um: float
@@ -84,12 +162,38 @@ class FrettingRun:
     dissipation: np.ndarray
     slipping: np.ndarray
     n_points: np.ndarray
+    slip_fraction: np.ndarray
     newton: int
+    boundaries: np.ndarray
     cycles: list
     normal: object
     solved: int
     k_normal: float
     k_tangential: float
+    steps_per_cycle: int
+    wall_time: float
+
+    def report(self, cycle: int = -1) -> CycleReport:
+        """The fretting figures of one cycle (default the last complete one)."""
+        if not self.cycles:
+            raise ValueError(f"the run at {self.amplitude_um:g} um has no complete cycle "
+                             f"({len(self.t)} increments)")
+        c = self.cycles[cycle]
+        span = slice(c["start"] + 1, c["end"] + 1)        # the cycle's own increments
+        slip = float(self.slip_fraction[span].max())
+        return CycleReport(amplitude_um=self.amplitude_um, cycle=c["cycle"],
+                           delta_um=c["delta_amplitude"] * 1e3,
+                           force_amplitude=c["force_amplitude"], energy=c["loop_energy"],
+                           dissipated=c["dissipated"], energy_ratio=c["energy_ratio"],
+                           slip_fraction=slip, regime=regime(min(slip, 1.0)),
+                           slipping_increments=int(np.count_nonzero(self.slipping[span])))
+
+
+def _cycle_line(amplitude_um, c, slip, n_cycles, seconds) -> str:
+    return (f"  a = {amplitude_um:g} um  cycle {c['cycle']}/{n_cycles}: F* = "
+            f"{c['force_amplitude']:.4g} N, E_d = {c['loop_energy']:.4e} N mm (interface "
+            f"{c['dissipated']:.4e}), A = {c['energy_ratio']:.4f}, slipping "
+            f"{100 * slip:.1f} % of the contact area  [{seconds:.1f} s]")
 
 
 class PreloadStiffness:
@@ -112,21 +216,29 @@ class PreloadStiffness:
 
 
 def run_amplitude(amplitude_um: float, *, size=2.0, height=1.0, mesh_size=0.5, order=1,
-                  pressure=10.0, cycles=2, steps_per_cycle=16, preload_steps=2, normal=None,
-                  comm=MPI.COMM_WORLD, verbose=False, loop_csv=None, checkpoint=None,
-                  restart=None, stop_after=None) -> FrettingRun:
+                  pressure=10.0, cycles=2, steps_per_cycle=32, wave="sine", preload_steps=2,
+                  normal=None, comm=MPI.COMM_WORLD, verbose=False, progress=True, loop_csv=None,
+                  interface_dir=None, overwrite=False, checkpoint=None, restart=None,
+                  stop_after=None, prefix="fret_") -> FrettingRun:
     """Preload to ``pressure`` [MPa] nominal, then ``cycles`` tangential cycles of amplitude
-    ``amplitude_um`` [um]. Collective; returns identical results on every rank.
+    ``amplitude_um`` [um] (``wave``: "sine" or "triangle", ``steps_per_cycle`` increments each,
+    a multiple of 4). Collective; returns identical results on every rank.
 
-    ``loop_csv``: file receiving one row per increment (``LOOP_COLUMNS``: the hysteresis loop
-    and the dissipation). ``checkpoint``: directory receiving a checkpoint per increment (with
-    the rows); ``restart``: such a directory to continue from (the rows and ``loop_csv``
-    continue); ``stop_after``: stop after this many increments (the result then covers them
-    only). ``solved`` in the result: the increments solved by this call; ``k_normal``,
-    ``k_tangential``: the interface's normal and tangential stiffness at the end of the preload
-    (int dp/dg dA, int dt_x/ds_x dA [N/mm]; kept with the checkpoints, so a restart past the
-    preload reports the measured values; NaN only when the run stopped before the preload's end).
+    ``progress``: print one line per cycle (and the end of the preload) on rank 0; ``verbose``:
+    also one per increment (``load_path``). ``loop_csv``: file receiving one row per increment
+    (``LOOP_COLUMNS``: the hysteresis loop, the dissipation, the slipping share).
+    ``interface_dir``: folder receiving ``interface.xdmf``/``interface.h5`` (the interface
+    fields per increment, time = the program's pseudo-time; ``overwrite`` replaces an earlier
+    run's). ``checkpoint``: directory receiving a checkpoint per increment (with the rows);
+    ``restart``: such a directory to continue from (the rows, ``loop_csv`` and the interface
+    series continue); ``stop_after``: stop after this many increments (the result then covers
+    them only). ``prefix``: PETSc options prefix of the solver. ``solved`` in the result: the
+    increments solved by this call; ``k_normal``, ``k_tangential``: the interface's normal and
+    tangential stiffness at the end of the preload (int dp/dg dA, int dt_x/ds_x dA [N/mm]; kept
+    with the checkpoints, so a restart past the preload reports the measured values; NaN only
+    when the run stopped before the preload's end).
     """
+    t0 = MPI.Wtime()
     a = check_scalar("amplitude", amplitude_um, lo=0.0, unit="um") * 1e-3
     check_scalar("pressure", pressure, lo=0.0, unit="MPa")
     key = (size, height, mesh_size, order, comm.py2f())
@@ -140,94 +252,173 @@ def run_amplitude(amplitude_um: float, *, size=2.0, height=1.0, mesh_size=0.5, o
                                       seating_pressure=pressure / preload_steps, normal=normal)
     clamp, ci = clamped_pair(scene, V, law, quadrature_degree=quadrature_degree(order))
     top = scene.tag("top")
-    prog = preload_then_cyclic(preload_steps, cycles, steps_per_cycle)
+    prog = preload_then_cyclic(preload_steps, cycles, steps_per_cycle, shape=wave)
     problem = preload_then_drive(scene, V, Material(flat_punch.E, flat_punch.NU), clamp, ci, top,
                                  force, a, "cyclic", prog.channels)
-    solver = SNESSolver(problem, prefix="fret_")
+    solver = SNESSolver(problem, prefix=prefix)
     rec = CsvRecorder(loop_csv, LOOP_COLUMNS, comm)
+    outputs = [rec]
+    writer = None
+    if interface_dir is not None:
+        writer = InterfaceWriter(interface_dir, ci, overwrite=overwrite,
+                                 resume=restart is not None)
+        outputs.append(writer)
     solved = 0
     k_interface = PreloadStiffness()          # restored with the checkpoint on a restart
     for inc in load_path(problem, solver, prog.times, verbose=verbose, checkpoint=checkpoint,
-                         resume=restart, outputs=[rec, k_interface], max_steps=stop_after):
+                         resume=restart, outputs=outputs + [k_interface],
+                         max_steps=stop_after):
+        s = ci.summary()
         rec.add((inc.load_factor, problem.scales["cyclic"] * a, problem.reaction(top)[0],
                  inc.contact_force[2], inc.dissipation, inc.n_slipping, inc.n_points,
-                 inc.newton_total))
+                 inc.newton_total, s.slipping_area / s.contact_area if s.contact_area > 0
+                 else 0.0))
+        if writer is not None:
+            writer.write(inc.load_factor, time=inc.load_factor)
         solved += 1
         if abs(inc.load_factor - 1.0) < 1e-12:         # end of the preload
             k_interface.value = ci.interface_stiffness()
+            if progress:
+                PETSc.Sys.Print(f"  a = {amplitude_um:g} um  preloaded: P = {force:g} N, "
+                                f"{problem.num_dofs} DOFs; interface stiffness normal "
+                                f"{k_interface.value[0]:.4e}, tangential "
+                                f"{k_interface.value[1]:.4e} N/mm "
+                                f"(before slip); then {cycles} cycles x {steps_per_cycle} "
+                                f"increments ({wave})  [{MPI.Wtime() - t0:.1f} s]", comm=comm)
+        elif progress and inc.load_factor > prog.cycle_start:
+            k = inc.load_factor - prog.cycle_start
+            if abs(k - round(k)) < 1e-9:                   # a cycle ends with this increment
+                rows = rec.array()
+                done = cycle_summary(rows[:, 0], prog, rows[:, 1], rows[:, 2], rows[:, 4])
+                if done:
+                    c = done[-1]
+                    slip = float(rows[c["start"] + 1:c["end"] + 1, 8].max())
+                    PETSc.Sys.Print(_cycle_line(amplitude_um, c, slip, cycles,
+                                                MPI.Wtime() - t0), comm=comm)
     solver.destroy()
-    t, u, fx, fz, d, slip, npts, its = rec.array().T
+    t, u, fx, fz, d, slip, npts, its, frac = rec.array().T
     return FrettingRun(amplitude_um=amplitude_um, force=force, dofs=problem.num_dofs, t=t, u=u,
                        fx=fx, fz=fz, dissipation=d, slipping=slip.astype(int),
-                       n_points=npts.astype(int), newton=int(its.sum()),
+                       n_points=npts.astype(int), slip_fraction=frac, newton=int(its.sum()),
+                       boundaries=cycle_boundaries(t, prog),
                        cycles=cycle_summary(t, prog, u, fx, d), normal=normal, solved=solved,
                        k_normal=float(k_interface.value[0]),
-                       k_tangential=float(k_interface.value[1]))
+                       k_tangential=float(k_interface.value[1]),
+                       steps_per_cycle=int(steps_per_cycle), wall_time=MPI.Wtime() - t0)
+
+
+def report_table(reports) -> str:
+    """The fretting table (one line per amplitude), as the demo prints it."""
+    lines = [f"  {'a [um]':>7} {'delta* [um]':>11} {'F* [N]':>8} {'E_d [N mm]':>11} "
+             f"{'A [-]':>7} {'slip [%]':>8} {'incr.':>5}  regime"]
+    for r in reports:
+        lines.append(f"  {r.amplitude_um:7.4g} {r.delta_um:11.4g} {r.force_amplitude:8.4g} "
+                     f"{r.energy:11.4e} {r.energy_ratio:7.4f} {100 * r.slip_fraction:8.1f} "
+                     f"{r.slipping_increments:5d}  {r.regime}")
+    return "\n".join(lines)
+
+
+def write_report_csv(path: str, reports) -> None:
+    """``fretting_map.csv`` (``REPORT_COLUMNS``), written atomically (rank 0 only)."""
+    text = io.StringIO(newline="")
+    w = csv.writer(text)
+    w.writerow(REPORT_COLUMNS)
+    for r in reports:
+        w.writerow([f"{v:.10g}" if isinstance(v, float) else v for v in r.row()])
+    atomic_write_text(path, text.getvalue())
 
 
 def run(amplitudes_um=(0.3, 0.5, 0.7, 1.0, 2.0, 4.0), outdir="results/fretting", plot=True,
-        comm=MPI.COMM_WORLD, checkpoint=None, restart=None, **kwargs) -> list:
-    """All amplitudes; returns a list of :class:`FrettingRun`; writes ``cycles.csv``,
-    ``loop_a<amplitude>um.csv`` (per increment) and PNGs in ``outdir``. Collective.
+        comm=MPI.COMM_WORLD, checkpoint=None, restart=None, xdmf=True, overwrite=False,
+        **kwargs) -> list:
+    """All amplitudes; returns a list of :class:`FrettingRun`. Collective. Writes in ``outdir``:
+
+    * ``fretting_map.csv``: per amplitude its last cycle (``REPORT_COLUMNS``: delta*, F*, E_d,
+      A, slipping share, regime), atomically; ``cycles.csv``: every cycle of every amplitude;
+    * ``loop_a<amplitude>um.csv``: per increment (``LOOP_COLUMNS``);
+    * ``a<amplitude>um/interface.xdmf`` (+ ``.h5``): the interface fields per increment
+      (``xdmf``; ``overwrite`` replaces an earlier run's);
+    * ``fretting.png`` (last loops, energy per cycle), ``fretting_loops.png`` (the last loop of
+      each amplitude in N and um), ``fretting_map.png`` (A and the slipping share against the
+      amplitude), ``loop_largest.png`` (every cycle of the largest amplitude).
 
     ``checkpoint``: directory receiving one checkpoint directory per amplitude; ``restart``: such
     a directory: finished amplitudes are read back from their last checkpoint (no solve), an
-    unfinished one continues, the others run (and checkpoint into ``restart``).
+    unfinished one continues, the others run (and checkpoint into ``restart``). ``kwargs`` go
+    to :func:`run_amplitude`.
     """
     results, normal = [], None
     if restart is not None:
         checkpoint = restart
-    for amp in amplitudes_um:
+    amps = [check_scalar("amplitude", a, lo=0.0, unit="um") for a in amplitudes_um]
+    if not amps:
+        raise ValueError("amplitudes_um is empty: give at least one amplitude [um]")
+    for i, amp in enumerate(amps):
         ck = None if checkpoint is None else os.path.join(checkpoint, f"a{amp:g}um")
         again = ck if restart is not None and has_checkpoint(ck, comm) else None
+        PETSc.Sys.Print(f"Amplitude {i + 1}/{len(amps)}: a = {amp:g} um"
+                        + (" (continued from its checkpoint)" if again else ""), comm=comm)
         r = run_amplitude(amp, normal=normal, comm=comm, checkpoint=ck, restart=again,
-                          loop_csv=os.path.join(outdir, f"loop_a{amp:g}um.csv"), **kwargs)
+                          loop_csv=os.path.join(outdir, f"loop_a{amp:g}um.csv"),
+                          interface_dir=os.path.join(outdir, f"a{amp:g}um") if xdmf else None,
+                          overwrite=overwrite, **kwargs)
         normal = r.normal
-        last = r.cycles[-1]
-        if not results:
-            PETSc.Sys.Print(f"  preloaded joint: interface normal stiffness {r.k_normal:.4e} "
-                            f"N/mm, tangential {r.k_tangential:.4e} N/mm (before slip)",
-                            comm=comm)
-        PETSc.Sys.Print(f"  a = {amp:8.4g} um: {r.dofs} DOFs, Newton {r.newton}, energy per "
-                        f"cycle {last['loop_energy']:.4e} N mm (interface {last['dissipated']:.4e}), "
-                        f"secant stiffness {last['secant_stiffness']:.4e} N/mm, max |Fx|/P "
-                        f"{np.abs(r.fx).max() / r.force:.3f}", comm=comm)
         results.append(r)
+    reports = [r.report() for r in results]
+    PETSc.Sys.Print(f"Fretting (last cycle of each amplitude; A = E_d / (4 F* delta*), slip = "
+                    f"largest slipping share of the contact area, incr. = increments with "
+                    f"slip):\n{report_table(reports)}", comm=comm)
     if comm.rank == 0:
         os.makedirs(outdir, exist_ok=True)
-        path = os.path.join(outdir, "cycles.csv")
-        with open(path + ".tmp", "w", newline="") as f:
-            w = csv.writer(f)
-            w.writerow(["amplitude_um", "cycle", "loop_energy_Nmm", "dissipated_Nmm",
-                        "secant_stiffness_N_per_mm"])
-            for r in results:
-                for c in r.cycles:
-                    w.writerow([r.amplitude_um, c["cycle"], c["loop_energy"], c["dissipated"],
-                                c["secant_stiffness"]])
-        os.replace(path + ".tmp", path)
+        write_report_csv(os.path.join(outdir, "fretting_map.csv"), reports)
+        text = io.StringIO(newline="")
+        w = csv.writer(text)
+        w.writerow(["amplitude_um", "cycle", "loop_energy_Nmm", "dissipated_Nmm",
+                    "force_amplitude_N", "energy_ratio", "secant_stiffness_N_per_mm"])
+        for r in results:
+            for c in r.cycles:
+                w.writerow([r.amplitude_um, c["cycle"], c["loop_energy"], c["dissipated"],
+                            c["force_amplitude"], c["energy_ratio"], c["secant_stiffness"]])
+        atomic_write_text(os.path.join(outdir, "cycles.csv"), text.getvalue())
         if plot:
-            _plot(results, outdir)
+            _plot(results, reports, outdir)
     return results
 
 
-def _plot(results, outdir):
+def stick_stiffness(results) -> float:
+    """The joint's stick stiffness [N/mm]: the secant F_x / u_x of the first increment of a
+    cycle in which nothing slipped yet (the smallest such u_x among the runs; NaN if none)."""
+    best = (np.inf, float("nan"))
+    for r in results:
+        if r.boundaries.size < 2:
+            continue
+        i = r.boundaries[0] + 1
+        du = r.u[i] - r.u[i - 1]
+        if r.slipping[i] == 0 and du != 0 and abs(du) < best[0]:
+            best = (abs(du), (r.fx[i] - r.fx[i - 1]) / du)
+    return best[1]
+
+
+def _plot(results, reports, outdir):
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
     from rough_contact.io import plotting
+    from rough_contact.references import fretting_energy_ratio
 
     fig = Figure(figsize=(11, 4.4))
     FigureCanvasAgg(fig)
     ax0, ax1 = fig.subplots(1, 2)
     for r in results:
-        ax0.plot(r.u * 1e3 / r.amplitude_um, r.fx / r.force, lw=1,
+        s, e = r.boundaries[-2], r.boundaries[-1]
+        ax0.plot(r.u[s:e + 1] * 1e3 / r.amplitude_um, r.fx[s:e + 1] / r.force, lw=1,
                  label=f"a = {r.amplitude_um:g} um")
     ax0.set_xlabel("u_x / a")
     ax0.set_ylabel("F_x / P")
-    ax0.set_title("hysteresis loops (all cycles)", fontsize=9)
+    ax0.set_title(f"hysteresis loops (cycle {reports[0].cycle}, the last)", fontsize=9)
     ax0.legend(fontsize=7)
     amp = np.array([r.amplitude_um for r in results])
-    energy = np.array([r.cycles[-1]["loop_energy"] for r in results])
+    energy = np.array([rep.energy for rep in reports])
     ok = energy > 1e-9 * max(energy.max(initial=0.0), 1e-300)   # round-off loops: no slip
     ax1.loglog(amp[ok], energy[ok], "o-", label="last cycle, loop area")
     if ok.sum() >= 2:
@@ -245,5 +436,50 @@ def _plot(results, outdir):
     ax1.set_title("energy dissipated per cycle vs amplitude", fontsize=9)
     fig.tight_layout()
     fig.savefig(os.path.join(outdir, "fretting.png"), dpi=120)
-    plotting.plot_hysteresis(results[-1].u, results[-1].fx,
+
+    # the last loop of every amplitude in physical units, one panel each
+    n = len(results)
+    cols = min(n, 4)
+    rows = -(-n // cols)
+    fig = Figure(figsize=(3.2 * cols, 3.0 * rows))
+    FigureCanvasAgg(fig)
+    axes = np.atleast_1d(fig.subplots(rows, cols)).ravel()
+    for ax in axes[n:]:
+        ax.set_visible(False)
+    for ax, r, rep in zip(axes, results, reports):
+        plotting.plot_hysteresis(r.u * 1e3, r.fx, boundaries=r.boundaries, cycles=[rep.cycle],
+                                 ax=ax, energy_unit="N um", xlabel="u_x [um]",
+                                 ylabel="F_x [N]")
+        ax.get_legend().remove()
+        ax.set_title(f"a = {rep.amplitude_um:g} um, cycle {rep.cycle}\nA = "
+                     f"{rep.energy_ratio:.3f}, {rep.regime}", fontsize=8)
+    fig.tight_layout()
+    fig.savefig(os.path.join(outdir, "fretting_loops.png"), dpi=120)
+
+    # fretting map: A and the slipping share against the amplitude
+    delta = np.array([rep.delta_um for rep in reports])
+    ratio = np.array([rep.energy_ratio for rep in reports])
+    slip = np.minimum([rep.slip_fraction for rep in reports], 1.0)
+    gross = [rep.delta_um for rep in reports if rep.regime == "gross slip"]
+    refs = {}
+    k = stick_stiffness(results)
+    force = np.array([rep.force_amplitude for rep in reports])
+    if np.isfinite(k) and len(gross):
+        sliding = delta >= min(gross)
+        refs["elastic joint + sliding (parallelogram)\n$A = 1 - F^*/(k\\,\\delta^*)$, "
+             f"k = {k:.3g} N/mm (gross slip)"] = (delta[sliding], 1.0 - force[sliding] / (
+                 k * delta[sliding] * 1e-3), "x")
+    if len(gross):
+        x = np.geomspace(delta.min(), delta.max(), 200)
+        refs["Mindlin-Deresiewicz (sphere on flat)\nwith $\\delta_t$ = first gross slip"] = (
+            x, fretting_energy_ratio(x / min(gross)))
+    if n >= 1 and np.all(delta > 0):
+        plotting.plot_fretting_map(delta, ratio, slip, references=refs,
+                                   transition=min(gross) if gross else None,
+                                   path=os.path.join(outdir, "fretting_map.png"),
+                                   title="fretting map (last cycle of each amplitude)")
+    plotting.plot_hysteresis(results[-1].u * 1e3, results[-1].fx,
+                             boundaries=results[-1].boundaries, energy_unit="N um",
+                             xlabel="u_x [um]", ylabel="F_x [N]",
+                             title=f"a = {results[-1].amplitude_um:g} um: every cycle",
                              path=os.path.join(outdir, "loop_largest.png"))

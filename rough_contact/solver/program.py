@@ -27,11 +27,11 @@ from typing import Callable, Dict, List
 
 import numpy as np
 
-from rough_contact.cycles import loop_energies
+from rough_contact.cycles import energy_ratio, loop_amplitudes, loop_energies
 from rough_contact.validation import check_scalar
 
 __all__ = ["LoadProgram", "proportional", "preload_then_hold", "preload_then_cyclic",
-           "cycle_index", "cycle_summary"]
+           "cycle_index", "cycle_boundaries", "cycle_summary"]
 
 
 @dataclass(frozen=True)
@@ -124,9 +124,40 @@ def cycle_index(times, program: LoadProgram) -> np.ndarray:
     return np.where(s <= 0.0, 0, np.ceil(s - 1e-9).astype(int))
 
 
+def cycle_boundaries(times, program: LoadProgram) -> np.ndarray:
+    """Where the program's complete cycles start and end among the increments: indices
+    ``b`` with cycle ``k`` (1-based) spanning the increments ``b[k - 1] .. b[k]`` (its first
+    entry is the last increment before cycle 1, e.g. the end of the preload). A cycle counts
+    when its last increment (pseudo-time ``cycle_start + k``) is among ``times``: a run stopped
+    inside a cycle ends at the last complete one. Empty (no complete cycle, or a program
+    without cycles) when there is nothing to split.
+
+    Args:
+        times: (n,) pseudo-times of the converged increments, increasing.
+        program: the program.
+
+    Returns:
+        (n_complete_cycles + 1,) increasing indices, or an empty integer array.
+    """
+    t = np.asarray(times, dtype=float)
+    if program.cycle_start is None or t.size == 0:
+        return np.zeros(0, dtype=int)
+    s = t - program.cycle_start
+    before = np.flatnonzero(s <= 1e-9)
+    if before.size == 0:
+        return np.zeros(0, dtype=int)
+    ends = np.flatnonzero((s > 0.5) & np.isclose(s, np.round(s), rtol=0.0, atol=1e-9))
+    # complete cycles only, in order 1, 2, ... (a cycle's end is its own increment)
+    k = np.round(s[ends]).astype(int)
+    ends = ends[k == np.arange(1, len(k) + 1)]
+    if ends.size == 0:
+        return np.zeros(0, dtype=int)
+    return np.r_[before[-1], ends].astype(int)
+
+
 def cycle_summary(times, program: LoadProgram, displacement, force, dissipation) -> list:
-    """Per cycle of a cyclic program: the loop energy, the interface dissipation and the secant
-    stiffness.
+    """Per cycle of a cyclic program: the loop energy, the interface dissipation, the
+    amplitudes, the energy ratio and the secant stiffness.
 
     Args:
         times: (n,) pseudo-times of the converged increments.
@@ -136,10 +167,13 @@ def cycle_summary(times, program: LoadProgram, displacement, force, dissipation)
         dissipation: (n,) cumulative interface dissipation [N mm].
 
     Returns:
-        One dict per complete cycle: ``cycle``, ``loop_energy`` (trapezoidal path integral of
-        F du over the cycle [N mm]), ``dissipated`` (interface dissipation of the cycle [N mm];
-        equal to the loop energy in a steady cycle), ``secant_stiffness`` ((F_max - F_min) /
-        (u_max - u_min) over the cycle [N/mm]).
+        One dict per complete cycle (:func:`cycle_boundaries`): ``cycle``, ``loop_energy``
+        (trapezoidal path integral of F du over the cycle [N mm]), ``dissipated`` (interface
+        dissipation of the cycle [N mm]; equal to the loop energy in a steady cycle),
+        ``delta_amplitude`` and ``force_amplitude`` (half the peak-to-peak u and F [mm], [N]),
+        ``energy_ratio`` (A = loop_energy / (4 F* delta*) [-]), ``secant_stiffness``
+        ((F_max - F_min) / (u_max - u_min) over the cycle [N/mm]), ``start`` and ``end`` (its
+        increments' indices).
     """
 
     t = np.asarray(times, dtype=float)
@@ -149,20 +183,15 @@ def cycle_summary(times, program: LoadProgram, displacement, force, dissipation)
     if not (len(t) == len(u) == len(f) == len(d)):
         raise ValueError(f"times, displacement, force and dissipation must have equal lengths, "
                          f"got {len(t)}, {len(u)}, {len(f)}, {len(d)}")
-    k = cycle_index(t, program)
-    out = []
-    for c in range(1, int(k.max(initial=0)) + 1):
-        idx = np.flatnonzero(k == c)
-        before = np.flatnonzero(k < c)
-        if idx.size == 0 or before.size == 0:
-            continue
-        if not np.isclose(t[idx[-1]] - program.cycle_start, c):
-            continue                     # incomplete cycle (a run stopped inside it)
-        s, e = int(before[-1]), int(idx[-1])
-        span = slice(s, e + 1)
-        du = u[span].max() - u[span].min()
-        out.append(dict(cycle=c, loop_energy=float(loop_energies(u, f, [s, e])[0]),
-                        dissipated=float(d[e] - d[s]),
-                        secant_stiffness=float((f[span].max() - f[span].min()) / du)
-                        if du > 0 else float("nan")))
-    return out
+    b = cycle_boundaries(t, program)
+    if b.size == 0:
+        return []
+    energy = loop_energies(u, f, b)
+    du, df = loop_amplitudes(u, f, b)
+    ratio = energy_ratio(energy, df, du)
+    return [dict(cycle=k + 1, loop_energy=float(energy[k]), dissipated=float(d[e] - d[s]),
+                 delta_amplitude=float(du[k]), force_amplitude=float(df[k]),
+                 energy_ratio=float(ratio[k]),
+                 secant_stiffness=float(df[k] / du[k]) if du[k] > 0 else float("nan"),
+                 start=int(s), end=int(e))
+            for k, (s, e) in enumerate(zip(b[:-1], b[1:]))]

@@ -3,8 +3,9 @@ files continue seamlessly"), serial and on 2 ranks.
 
 Reference: the same amplitude run without interruption. A run stopped after 5 increments
 (its checkpoint written) and continued from the checkpoint directory gives the uninterrupted
-run's hysteresis loop (u_x, F_x) and dissipation to 1e-12, and its per-increment CSV holds every
-increment once. The all-amplitudes driver restarted from a checkpoint directory reads back a
+run's hysteresis loop (u_x, F_x) and dissipation to 1e-12; its per-increment CSV and its
+interface XDMF hold every increment once (the XDMF fields those of the uninterrupted run to
+1e-10 of their size). The all-amplitudes driver restarted from a checkpoint directory reads back a
 finished amplitude without solving it again (same loop, 0 Newton iterations spent on it) and runs
 the missing one. The joint's interface stiffness measured at the end of the preload is kept
 with the checkpoint: a run continued past the preload reports the uninterrupted run's value
@@ -14,12 +15,14 @@ with the checkpoint: a run continued past the preload reports the uninterrupted 
 from __future__ import annotations
 
 import csv
+import os
 
 import numpy as np
 import pytest
 from mpi4py import MPI
 
 from rough_contact.fem import compat
+from rough_contact.io.interface_output import read_interface_results
 from rough_contact.scenes import fretting
 
 SMALL = dict(cycles=1, steps_per_cycle=8, mesh_size=0.5, order=1)
@@ -30,11 +33,14 @@ def _tmp(tmp_path, name):
 
 
 def test_stopped_amplitude_continues(tmp_path):
-    full = fretting.run_amplitude(2.0, **SMALL)
+    xfull, xpart = _tmp(tmp_path, "xdmf_full"), _tmp(tmp_path, "xdmf_part")
+    full = fretting.run_amplitude(2.0, interface_dir=xfull, **SMALL)
     ck, loop = _tmp(tmp_path, "ck"), _tmp(tmp_path, "loop.csv")
-    part = fretting.run_amplitude(2.0, checkpoint=ck, loop_csv=loop, stop_after=5, **SMALL)
+    part = fretting.run_amplitude(2.0, checkpoint=ck, loop_csv=loop, stop_after=5,
+                                  interface_dir=xpart, **SMALL)
     assert len(part.t) == 5
-    rest = fretting.run_amplitude(2.0, checkpoint=ck, restart=ck, loop_csv=loop, **SMALL)
+    rest = fretting.run_amplitude(2.0, checkpoint=ck, restart=ck, loop_csv=loop,
+                                  interface_dir=xpart, **SMALL)
     assert len(rest.t) == len(full.t) and rest.solved == len(full.t) - 5
     for key in ("t", "u", "fx", "fz", "dissipation"):
         scale = np.abs(getattr(full, key)).max()
@@ -52,6 +58,16 @@ def test_stopped_amplitude_continues(tmp_path):
         assert len(rows) == len(full.t)
         np.testing.assert_allclose([float(r["F_x_N"]) for r in rows], full.fx, rtol=1e-11,
                                    atol=1e-11 * np.abs(full.fx).max())
+    # the interface series continues: every increment once, the uninterrupted run's fields
+    a = read_interface_results(os.path.join(xfull, "interface.xdmf"))
+    b = read_interface_results(os.path.join(xpart, "interface.xdmf"))
+    np.testing.assert_allclose(b.times, full.t, rtol=1e-14)
+    np.testing.assert_allclose(a.times, full.t, rtol=1e-14)
+    for step in (4, 5, len(full.t) - 1):
+        for name in ("pressure_MPa", "shear_traction_MPa", "slip_fraction"):
+            fa, fb = a.field(name, step), b.field(name, step)
+            np.testing.assert_allclose(fb, fa, rtol=0, atol=1e-10 * max(np.abs(fa).max(), 1),
+                                       err_msg=f"{name} at step {step}")
 
 
 def test_driver_restart_reads_finished_amplitudes(tmp_path):
@@ -59,6 +75,11 @@ def test_driver_restart_reads_finished_amplitudes(tmp_path):
     first = fretting.run([0.5], outdir=out, plot=False, checkpoint=ck, **SMALL)
     again = fretting.run([0.5, 2.0], outdir=out, plot=False, restart=ck, **SMALL)
     assert again[0].solved == 0 and first[0].solved == len(first[0].t)  # read back
+    assert again[0].report() == first[0].report()          # the same last-cycle figures
+    for r in again:                                        # one interface step per increment
+        res = read_interface_results(os.path.join(out, f"a{r.amplitude_um:g}um",
+                                                  "interface.xdmf"))
+        np.testing.assert_allclose(res.times, r.t, rtol=1e-14)
     np.testing.assert_allclose(again[0].fx, first[0].fx, rtol=0,
                                atol=1e-12 * np.abs(first[0].fx).max())
     assert again[1].solved == len(again[1].t) == len(first[0].t)

@@ -89,3 +89,67 @@ def test_hertz_closed_forms_are_consistent():
 def test_references_import_no_fe_stack(imports_without):
     """The oracles are pure numpy: importing them pulls in no DOLFINx, MPI or PETSc."""
     imports_without(["rough_contact.references"])
+
+
+def _masing_fretting_loop(delta_s):
+    """Q* and the loop area under an imposed displacement amplitude delta*, built numerically:
+    the virgin curve Q(delta) by root-finding on Mindlin's delta(Q) (saturating at mu P beyond
+    the sliding approach), Masing's branches U(d) = -Q* + 2 Q((d + delta*) / 2) and
+    L(d) = -U(-d), the area by quadrature."""
+    from scipy.optimize import brentq
+
+    K = ref.sliding_approach(MU, P, A, G, NU)
+
+    def virgin(d):
+        if d >= K:
+            return MU * P
+        return brentq(lambda Q: ref.tangential_approach(Q, MU, P, A, G, NU) - d, 0.0, MU * P,
+                      xtol=1e-14 * MU * P, rtol=1e-15)
+
+    Qs = virgin(delta_s)
+
+    def upper(d):
+        return -Qs + 2.0 * virgin(0.5 * (d + delta_s))
+
+    kinks = [k for k in (2 * K - delta_s,) if -delta_s < k < delta_s]
+    area = quad(lambda d: upper(d) + upper(-d), -delta_s, delta_s, points=kinks or None,
+                epsabs=0, epsrel=1e-10, limit=200)[0]
+    return Qs, area
+
+
+@pytest.mark.parametrize("x", [0.1, 0.5, 0.9, 1.0, 1.3, 2.0, 5.0])
+def test_fretting_cycle_is_the_masing_loop_under_imposed_displacement(x):
+    """Energy, force amplitude and energy ratio A = W / (4 Q* delta*) of fretting_cycle against
+    the loop built numerically from the monotonic curve (partial and gross slip)."""
+    K = ref.sliding_approach(MU, P, A, G, NU)
+    Qs, area = _masing_fretting_loop(x * K)
+    Q, W, ratio = ref.fretting_cycle(x * K, MU, P, A, G, NU)
+    assert Q == pytest.approx(Qs, rel=1e-9)
+    assert W == pytest.approx(area, rel=1e-7)
+    assert ratio == pytest.approx(area / (4 * Qs * x * K), rel=1e-7)
+
+
+def test_fretting_energy_ratio_limits():
+    """Closed forms derived by hand: A -> delta* / (12 delta_t) for small amplitudes
+    (W ~ 5/162 q^3 x 4.8 mu P delta_t, delta* ~ 2/3 q delta_t), A = 0.2 at the transition
+    delta* = delta_t (Fouvry's A_t of a sphere on a flat), A = 1 - 0.8 delta_t / delta* in
+    gross slip (-> 1: the rectangle of rigid-plastic sliding), and no energy without motion."""
+    K = ref.sliding_approach(MU, P, A, G, NU)
+    d = np.array([1e-4, 1e-3]) * K
+    ratio = ref.fretting_cycle(d, MU, P, A, G, NU)[2]
+    np.testing.assert_allclose(ratio, d / (12 * K), rtol=2e-3)
+    assert ref.fretting_cycle(K, MU, P, A, G, NU)[2] == pytest.approx(0.2, rel=1e-12)
+    x = np.array([1.0, 1.5, 3.0, 100.0])
+    np.testing.assert_allclose(ref.fretting_cycle(x * K, MU, P, A, G, NU)[2], 1 - 0.8 / x,
+                               rtol=1e-12)
+    Q, W, ratio = ref.fretting_cycle(0.0, MU, P, A, G, NU)
+    assert Q == W == ratio == 0.0
+    # A rises monotonically through the transition
+    a_of_x = ref.fretting_cycle(np.linspace(0.01, 4, 400) * K, MU, P, A, G, NU)[2]
+    assert np.all(np.diff(a_of_x) > 0)
+    with pytest.raises(ValueError, match="delta_amplitude = -1"):
+        ref.fretting_cycle(-1.0, MU, P, A, G, NU)
+    # the dimensionless form used by the fretting map
+    x = np.array([0.2, 1.0, 2.5])
+    np.testing.assert_allclose(ref.fretting_energy_ratio(x),
+                               ref.fretting_cycle(x * K, MU, P, A, G, NU)[2], rtol=1e-12)

@@ -123,6 +123,121 @@ def test_loop_energy_equals_parallelogram_area(tmp_path):
     np.testing.assert_array_equal(cycles[1].get_ydata(), f[b[1]:])
 
 
+def sliding_spring(u, F0, k):
+    """Force of a spring k in series with a Coulomb slider F0 along the path u (starting
+    unloaded): the elastic-perfectly-sliding joint whose steady loop is a parallelogram."""
+    f = np.zeros_like(u)
+    for i in range(1, len(u)):
+        f[i] = np.clip(f[i - 1] + k * (u[i] - u[i - 1]), -F0, F0)
+    return f
+
+
+def program_path(cycles=3, steps=16, a=8e-3, F0=40.0, k=2e4):
+    """A preload + ``cycles`` triangle cycles of amplitude ``a`` [mm] (16 increments per cycle:
+    u moves by a / 4 per increment) through the sliding spring; F0 / k = a / 4, so the stick
+    range 2 F0 / k after a reversal ends on an increment and the sampled path is the exact
+    parallelogram (the trapezoidal loop area is then exact)."""
+    from rough_contact.solver.program import preload_then_cyclic
+
+    prog = preload_then_cyclic(2, cycles, steps)
+    u = a * np.array([prog.channels["cyclic"](t) for t in prog.times])
+    return prog, u, sliding_spring(u, F0, k)
+
+
+def test_plotted_cycles_are_the_programs_cycles(tmp_path):
+    """Issue 24 item 16: a 3-cycle program (0 -> +a -> -a -> 0 per cycle) plots as 3 closed
+    loops when its cycle boundaries are passed; without them the path is cut at the minima into
+    4 pieces, the first and last open, and those get no loop energy in the legend."""
+    from rough_contact.solver.program import cycle_boundaries
+
+    a, F0, k = 8e-3, 40.0, 2e4
+    prog, u, f = program_path(a=a, F0=F0, k=k)
+    b = cycle_boundaries(prog.times, prog)
+    # the preload ends at increment 1 (t = 1); cycle c ends at t = 1 + c, 16 increments later
+    assert b.tolist() == [1, 17, 33, 49]
+    fig = plotting.plot_hysteresis(u, f, boundaries=b, path=tmp_path / "loops.png")
+    assert_png(tmp_path / "loops.png")
+    lines = [ln for ln in fig.axes[0].get_lines() if ln.get_label().startswith("cycle")]
+    assert [ln.get_label().split(":")[0] for ln in lines] == ["cycle 1", "cycle 2", "cycle 3"]
+    for c, ln in enumerate(lines, start=1):
+        np.testing.assert_array_equal(ln.get_xdata(), u[b[c - 1]:b[c] + 1])
+        np.testing.assert_array_equal(ln.get_ydata(), f[b[c - 1]:b[c] + 1])
+        assert ln.get_xdata()[0] == ln.get_xdata()[-1] == 0.0        # closed: from 0 to 0
+    exact = 4.0 * F0 * (a - F0 / k)                                  # the parallelogram
+    for ln in lines[1:]:                                             # cycle 1 starts unloaded
+        assert f"{exact:.4g}" in ln.get_label()
+    # only the last cycle, numbered as in the program
+    fig = plotting.plot_hysteresis(u, f, boundaries=b, cycles=[3])
+    assert [ln.get_label().split(":")[0] for ln in fig.axes[0].get_lines()
+            if ln.get_label()[:1] in "cp"] == ["cycle 3"]
+    with pytest.raises(ValueError, match="cycles \\[4\\] are invalid: the path has cycles 1 .. 3"):
+        plotting.plot_hysteresis(u, f, boundaries=b, cycles=[4])
+    # the old call: split at the minima -> 4 pieces, 2 of them open paths without a loop energy
+    fig = plotting.plot_hysteresis(u, f)
+    labels = [ln.get_label() for ln in fig.axes[0].get_lines() if ln.get_label()[:1] in "cp"]
+    assert len(labels) == 4
+    assert ["open path" in lab for lab in labels] == [True, False, False, True]
+    assert not any("oint" in lab for lab in labels if "open path" in lab)
+
+
+def test_cycle_summary_energy_ratio_of_a_parallelogram_and_a_rectangle():
+    """A = E_d / (4 F* delta*): 1 - delta_s / delta* = 3/4 for the sampled parallelogram of
+    the sliding spring (delta_s = F0 / k = a / 4; E_d = 4 F0 (a - a / 4)), 1 for a rectangle
+    (rigid-plastic sliding: E_d = 2 F0 x 2 a), 0 for an elastic line."""
+    from rough_contact.cycles import energy_ratio, loop_amplitudes, loop_energies
+    from rough_contact.solver.program import cycle_summary
+
+    a, F0, k = 8e-3, 40.0, 2e4
+    prog, u, f = program_path(a=a, F0=F0, k=k)
+    rows = cycle_summary(prog.times, prog, u, f, np.zeros_like(u))
+    assert [r["cycle"] for r in rows] == [1, 2, 3]
+    for r in rows[1:]:
+        assert r["loop_energy"] == pytest.approx(3.0 * F0 * a, rel=1e-12)
+        assert (r["delta_amplitude"], r["force_amplitude"]) == (pytest.approx(a), F0)
+        assert r["energy_ratio"] == pytest.approx(0.75, rel=1e-12)
+        assert r["secant_stiffness"] == pytest.approx(F0 / a, rel=1e-12)
+    # rectangle: 0 -> a at +F0, drop to -F0, -> -a, up to +F0, -> 0 (vertical edges: two
+    # increments at the same u)
+    u = a * np.array([0.0, 0.5, 1.0, 1.0, 0.0, -1.0, -1.0, 0.0])
+    f = F0 * np.array([1.0, 1.0, 1.0, -1.0, -1.0, -1.0, 1.0, 1.0])
+    b = [0, 7]
+    E = loop_energies(u, f, b)
+    du, df = loop_amplitudes(u, f, b)
+    assert E[0] == pytest.approx(4.0 * F0 * a, rel=1e-14)
+    assert energy_ratio(E, df, du)[0] == pytest.approx(1.0, rel=1e-14)
+    # elastic line: no area
+    u = a * np.array([0.0, 1.0, 0.0, -1.0, 0.0])
+    assert energy_ratio(loop_energies(u, 1e4 * u, [0, 4]), *loop_amplitudes(u, 1e4 * u, [0, 4]))[
+        0] == pytest.approx(0.0, abs=1e-15)
+    with pytest.raises(ValueError, match="force_amplitude -1 N"):
+        energy_ratio(1.0, -1.0, 1.0)
+
+
+def test_cycle_boundaries_of_an_incomplete_run():
+    """A run stopped inside cycle 3 has two complete cycles; before cycle 1 ends, none."""
+    from rough_contact.solver.program import cycle_boundaries, preload_then_cyclic
+
+    prog = preload_then_cyclic(2, 3, 8)
+    assert cycle_boundaries(prog.times[:22], prog).tolist() == [1, 9, 17]
+    assert cycle_boundaries(prog.times[:8], prog).size == 0
+    assert cycle_boundaries(prog.times, prog).tolist() == [1, 9, 17, 25]
+
+
+def test_fretting_map(tmp_path):
+    fig = plotting.plot_fretting_map([0.3, 0.5, 1.0, 4.0], [0.0, 0.03, 0.3, 0.74],
+                                     [0.0, 1.0, 1.0, 1.0], transition=0.5,
+                                     references={"parallelogram": ([1.0, 4.0], [0.1, 0.77])},
+                                     path=tmp_path / "map.png")
+    assert_png(tmp_path / "map.png")
+    ax0, ax1 = fig.axes
+    np.testing.assert_array_equal(ax0.get_lines()[0].get_ydata(), [0.0, 0.03, 0.3, 0.74])
+    np.testing.assert_array_equal(ax1.get_lines()[0].get_ydata(), [0.0, 100.0, 100.0, 100.0])
+    with pytest.raises(ValueError, match="slip_fraction"):
+        plotting.plot_fretting_map([1.0], [0.1], [1.5])
+    with pytest.raises(ValueError, match="amplitude"):
+        plotting.plot_fretting_map([0.0], [0.1], [0.5])
+
+
 def test_split_cycles_with_flat_steps():
     u = np.array([0.0, 1.0, 1.0, 0.0, -1.0, -1.0, -1.0, 0.0, 1.0, 0.0])
     assert plotting.split_cycles(u).tolist() == [0, 4, 9]
