@@ -41,6 +41,7 @@ S1 = SpectralMoments(m00=0.0625, m20=8e-5, m02=8e-4, m40=1.04e-6, m04=1.04e-4)
 #   PYTHONPATH=. python benchmarks/unloading_reference.py S_MIN X 1e-7
 REFERENCE = {
     (0.0, 1.0): (6.25580463e+01, 5.89893577e+05, 4.82540382e-02),
+    (-1.0, 3.0): (5.90130848e-01, 1.08527540e+04, 8.44866135e-04),
 }
 
 
