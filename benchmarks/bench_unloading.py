@@ -10,8 +10,14 @@ Prints three tables:
      quadrature (n_quad 24, n_t 16) at random points (p, k, A/A0, errors relative to
      max(p, 1e-6 p_load(h_min))).
 
+  4. (--convergence) the direct unloading sums p, k, A/A0 against the number of nodes
+     (n_quad of the (zeta, K) shape rule at n_t 24; n_t of the height rule at n_quad 24),
+     relative to n_quad 40 / n_t 48, on three rows h_min = -3, 0, 3 sigma and unloading
+     distances up to 6.75 sigma; and the values against the independent nested-quad
+     reference (benchmarks/unloading_reference.py) at the points listed in REFERENCE.
+
 Usage: .venv/bin/python benchmarks/bench_unloading.py [--rtol 1e-3] [--psi 1.0] [--table]
-       [--n-quad 12] [--n-t 16] [--max-points 20000]
+       [--convergence] [--n-quad 16] [--n-t 16] [--max-points 20000]
 """
 import argparse
 import math
@@ -30,6 +36,43 @@ from rough_contact.surface import SpectralMoments
 
 S1 = SpectralMoments(m00=0.0625, m20=8e-5, m02=8e-4, m40=1.04e-6, m04=1.04e-4)
 
+# (h_min/sigma, u/sigma): (p [MPa], k [MPa/mm], A/A0) from benchmarks/unloading_reference.py
+# at epsrel 1e-7 (psi = 1, E* = 1.14e5 MPa); recompute with
+#   PYTHONPATH=. python benchmarks/unloading_reference.py S_MIN X 1e-7
+REFERENCE = {
+    (0.0, 1.0): (6.25580463e+01, 5.89893577e+05, 4.82540382e-02),
+    (-1.0, 3.0): (5.90130848e-01, 1.08527540e+04, 8.44866135e-04),
+}
+
+
+def convergence(mat):
+    sig = S1.rq
+    xs = np.array([0.0, 0.3, 1.0, 2.0, 3.0, 5.0, 6.75])
+    print("\ndirect unloading sums: max relative difference of p, k, A/A0 over u/sigma in "
+          f"{list(xs)} to the finest rule")
+    print(f"{'h_min/sigma':>11s} {'rule':>16s} {'p':>9s} {'k':>9s} {'A/A0':>9s} {'s':>6s}")
+    for s_min in (-3.0, 0.0, 3.0):
+        hm = s_min * sig
+        base = np.array(U._row_sums(S1, mat, hm, xs * sig, 40, 24)[:3])
+        for n in (8, 12, 16, 24, 32):
+            t = time.perf_counter()
+            r = np.array(U._row_sums(S1, mat, hm, xs * sig, n, 24)[:3])
+            e = np.max(np.abs(r / base - 1), axis=1)
+            print(f"{s_min:11.1f} {'n_quad %d' % n:>16s} {e[0]:9.1e} {e[1]:9.1e} {e[2]:9.1e} "
+                  f"{time.perf_counter() - t:6.1f}")
+        base = np.array(U._row_sums(S1, mat, hm, xs * sig, 24, 48)[:3])
+        for n in (8, 12, 16, 24, 32):
+            r = np.array(U._row_sums(S1, mat, hm, xs * sig, 24, n)[:3])
+            e = np.max(np.abs(r / base - 1), axis=1)
+            print(f"{s_min:11.1f} {'n_t %d' % n:>16s} {e[0]:9.1e} {e[1]:9.1e} {e[2]:9.1e}")
+    print("\nagainst the independent nested quad (relative differences of p, k, A/A0)")
+    for (s_min, x), ref in REFERENCE.items():
+        for n in (12, 16, 24, 32):
+            r = np.array(U._row_sums(S1, mat, s_min * sig, np.array([x * sig]), n, 24)[:3])[:, 0]
+            e = r / np.array(ref) - 1
+            print(f"h_min = {s_min:4.1f} sigma, u = {x:4.2f} sigma, n_quad {n:2d}: "
+                  f"{e[0]:9.1e} {e[1]:9.1e} {e[2]:9.1e}")
+
 
 def rate(fn, n, reps=5):
     fn()
@@ -44,7 +87,8 @@ def main():
     ap.add_argument("--rtol", type=float, default=1e-3)
     ap.add_argument("--psi", type=float, default=1.0)
     ap.add_argument("--table", action="store_true")
-    ap.add_argument("--n-quad", type=int, default=12)
+    ap.add_argument("--convergence", action="store_true")
+    ap.add_argument("--n-quad", type=int, default=16)
     ap.add_argument("--n-t", type=int, default=16)
     ap.add_argument("--max-points", type=int, default=20000,
                     help="direct-sum budget of the history table (strict=False: the last table)")
@@ -58,6 +102,8 @@ def main():
               f"{float(U.ekk_residual_ratio(ws)):8.4f}")
 
     mat = AsperityMaterial(E_star=1.14e5, psi=a.psi).resolve(S1)
+    if a.convergence:
+        convergence(mat)
     t = time.perf_counter()
     load = NormalLaw.elasto_plastic(S1, mat, a.rtol)
     t_load = time.perf_counter() - t

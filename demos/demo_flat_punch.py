@@ -72,9 +72,11 @@ def parse_args(argv):
     parser.add_argument("--case", default="b", choices=["a", "b", "c", "none"],
                         help="friction case of Fig 18")
     parser.add_argument("--normal-law", default="elasto-plastic",
-                        choices=["elastic", "elasto-plastic"],
+                        choices=["elastic", "elasto-plastic", "elastic-memory",
+                                 "elasto-plastic-memory"],
                         help="asperity population of the normal law (elasto-plastic: Y, psi, ch, "
-                        "omega_p/omega_c of Figs 18-19)")
+                        "omega_p/omega_c of Figs 18-19); '-memory': the irreversible law that "
+                        "remembers the smallest separation (docs/unloading.md)")
     parser.add_argument("--outdir", default="results/flat_punch")
     parser.add_argument("--checkpoint", default=None, metavar="DIR",
                         help="write a checkpoint after every converged increment into DIR")

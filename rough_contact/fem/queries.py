@@ -13,11 +13,14 @@ Units: mm, N, MPa.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Optional
 
 import numpy as np
 from mpi4py import MPI
 
 from rough_contact.interface.contract import LawResult
+from rough_contact.interface.law import InterfaceLaw
+from rough_contact.interface.state import HistoryInterfaceState
 
 __all__ = ["InterfaceQueries", "InterfaceSummary", "PointFields"]
 
@@ -45,6 +48,9 @@ class InterfaceSummary:
         dissipation: committed accumulated frictional dissipation int D dA [N mm].
         n_beyond_validity: points where the law reports evaluation outside its model's range
             (``LawResult.beyond_validity``; 0 for a law without such a limit).
+        normal_dissipation: committed accumulated normal hysteresis energy int D_N dA [N mm]
+            of a normal law with memory (``LawResult.normal_dissipation``; 0 for a
+            reversible law).
     """
 
     n_points: int
@@ -59,6 +65,7 @@ class InterfaceSummary:
     max_plastic_slip: float
     dissipation: float
     n_beyond_validity: int = 0
+    normal_dissipation: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -76,6 +83,11 @@ class PointFields:
         contact: (n,) bool.
         slipping: (n,) bool, in contact and slipping.
         weight: (n,) quadrature weight = area represented by the point [mm^2].
+        h_min, residual_closure, normal_dissipation: only for a normal law with memory
+            (state ``HistoryInterfaceState``), else None: (n,) smallest mean-plane separation
+            reached (committed; +inf where virgin) [mm]; h0 - h_min, the largest closure
+            reached, which the unloading branch remembers (0 where virgin) [mm]; committed
+            accumulated normal hysteresis energy per area [N/mm].
     """
 
     pressure: np.ndarray
@@ -88,6 +100,9 @@ class PointFields:
     contact: np.ndarray
     slipping: np.ndarray
     weight: np.ndarray
+    h_min: Optional[np.ndarray] = None
+    residual_closure: Optional[np.ndarray] = None
+    normal_dissipation: Optional[np.ndarray] = None
 
 
 class InterfaceQueries:
@@ -154,7 +169,7 @@ class InterfaceQueries:
             float(w[slipping].sum()), float(np.dot(self.history.law.dissipated, w)),
             float((res.contact & own).sum()), float((slipping & own).sum()),
             0.0 if res.beyond_validity is None else float((res.beyond_validity & own).sum()),
-            float(own.sum())]])
+            float(own.sum()), float(np.dot(self.history.law.normal_dissipated, w))]])
         sums = self.comm.allreduce(sums, op=MPI.SUM)
         slip = np.linalg.norm(self._last_jump[:, 1:], axis=1)
         plastic = np.linalg.norm(self.history.law.trial.plastic_slip, axis=1)
@@ -165,7 +180,8 @@ class InterfaceQueries:
             contact_force=sums[:3], real_area=float(sums[3]), nominal_area=float(sums[4]),
             contact_area=float(sums[5]), slipping_area=float(sums[6]),
             max_slip=float(maxima[0]), max_plastic_slip=float(maxima[1]),
-            dissipation=float(sums[7]), n_beyond_validity=int(sums[10]))
+            dissipation=float(sums[7]), n_beyond_validity=int(sums[10]),
+            normal_dissipation=float(sums[12]))
 
     @property
     def facets(self) -> np.ndarray:
@@ -200,7 +216,27 @@ class InterfaceQueries:
             contact=np.asarray(res.contact),
             slipping=np.asarray(res.slipping) & np.asarray(res.contact),
             weight=self.paired.weights,
+            **self._memory_fields(),
         )
+
+    def normal_dissipation(self) -> float:
+        """Committed accumulated normal hysteresis energy int D_N dA [N mm] (collective; 0 for
+        a reversible normal law)."""
+        return self.comm.allreduce(float(np.dot(self.history.law.normal_dissipated,
+                                                self.paired.weights)), op=MPI.SUM)
+
+    def _memory_fields(self) -> dict:
+        """h_min, residual closure and normal dissipation per point (PointFields), empty for a
+        law without normal memory."""
+        committed = self.history.law.committed
+        if not isinstance(committed, HistoryInterfaceState):
+            return {}
+        h_min = np.array(committed.h_min, dtype=float)
+        h0 = self.law.h0 if isinstance(self.law, InterfaceLaw) else None
+        closure = (np.zeros_like(h_min) if h0 is None
+                   else np.where(np.isfinite(h_min), np.maximum(float(h0) - h_min, 0.0), 0.0))
+        return {"h_min": h_min, "residual_closure": closure,
+                "normal_dissipation": self.history.law.normal_dissipated.copy()}
 
 
 def _read_only(a: np.ndarray) -> np.ndarray:

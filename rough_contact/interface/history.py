@@ -182,7 +182,7 @@ class HistoryNormalLaw:
 
     @classmethod
     def elasto_plastic(cls, surface, material, rtol: float = 1e-4, *, loading=None,
-                       n_quad: int = 16, n_t: int = 8, n_rows: int = 8, n_x: int = 8,
+                       n_quad: int = 16, n_t: int = 16, n_rows: int = 8, n_x: int = 8,
                        tail: float = 1e-12, max_points: int = 20000,
                        max_seconds: float = 600.0, strict: bool = True) -> "HistoryNormalLaw":
         """Table of the elasto-plastic population with memory (reading "consistent").

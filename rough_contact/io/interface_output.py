@@ -66,7 +66,7 @@ from rough_contact.io.files import (OutputExistsError, atomic_write_text, check_
 __all__ = [
     "STATUS_OPEN", "STATUS_STICK", "STATUS_SLIP", "STATUS_NAMES", "InterfaceOutputSource",
     "PointOutput", "FacetOutput", "SurfaceMesh", "InterfaceWriter", "InterfaceResults",
-    "FACET_FIELD_NAMES", "POINT_FIELD_NAMES", "facet_average", "facet_status",
+    "FACET_FIELD_NAMES", "POINT_FIELD_NAMES", "MEMORY_FIELD_NAMES", "facet_average", "facet_status",
     "point_output", "facet_output", "facet_vertex_coordinates", "gather_surface",
     "pseudo_time", "read_interface_results",
 ]
@@ -137,9 +137,16 @@ class PointOutput(_InterfaceFields):
         dissipation: (n,) accumulated frictional dissipation per area [N/mm] (= mJ/mm^2).
         status: (n,) int32, 0 open, 1 stick, 2 slip.
         weight: (n,) area represented by the point [mm^2].
+        h_min, residual_closure, normal_dissipation: (n,) only for a normal law with memory
+            (else None): smallest separation reached [mm] (NaN where virgin), the largest
+            closure reached h0 - h_min [mm], accumulated normal hysteresis energy per area
+            [N/mm]; written as ``MEMORY_FIELD_NAMES``.
     """
 
     weight: np.ndarray
+    h_min: Optional[np.ndarray] = None
+    residual_closure: Optional[np.ndarray] = None
+    normal_dissipation: Optional[np.ndarray] = None
 
 
 @dataclass(frozen=True)
@@ -153,11 +160,15 @@ class FacetOutput(_InterfaceFields):
         contact_fraction: (n_f,) part of the facet's area in contact [-].
         slip_fraction: (n_f,) part of the facet's area slipping [-].
         area: (n_f,) facet area, sum of its quadrature weights [mm^2].
+        residual_closure, normal_dissipation: (n_f,) averages (normal law with memory only,
+            else None).
     """
 
     contact_fraction: np.ndarray
     slip_fraction: np.ndarray
     area: np.ndarray
+    residual_closure: Optional[np.ndarray] = None
+    normal_dissipation: Optional[np.ndarray] = None
 
 
 # (attribute, name in the file); the order is the order of the arrays in ParaView's lists
@@ -169,6 +180,10 @@ _FIELDS = (
 )
 FACET_FIELD_NAMES = tuple(n for _, n in _FIELDS) + ("contact_fraction", "slip_fraction")
 POINT_FIELD_NAMES = tuple(n for _, n in _FIELDS) + ("weight_mm2",)
+# written besides, only when the normal law has memory (h_min at the points only)
+_MEMORY = (("residual_closure", "residual_closure_mm"),
+           ("normal_dissipation", "normal_dissipation_N_per_mm"), ("h_min", "h_min_mm"))
+MEMORY_FIELD_NAMES = tuple(n for _, n in _MEMORY)
 
 
 def _check_points(weights: np.ndarray, n_qp: int) -> np.ndarray:
@@ -254,6 +269,10 @@ def point_output(interface: InterfaceOutputSource) -> PointOutput:
         dissipation=np.asarray(pf.dissipation, dtype=float),
         status=_point_status(pf.contact, pf.slipping),
         weight=np.asarray(pf.weight, dtype=float),
+        **({} if pf.normal_dissipation is None else {
+            "h_min": np.where(np.isfinite(pf.h_min), pf.h_min, np.nan).astype(float),
+            "residual_closure": np.asarray(pf.residual_closure, dtype=float),
+            "normal_dissipation": np.asarray(pf.normal_dissipation, dtype=float)}),
     )
 
 
@@ -266,6 +285,9 @@ def facet_output(interface: InterfaceOutputSource,
                                                            po.status == STATUS_SLIP, w, n_qp)
     avg = {attr: facet_average(getattr(po, attr), w, n_qp)
            for attr, _ in _FIELDS if attr != "status"}
+    if po.normal_dissipation is not None:
+        avg.update({a: facet_average(getattr(po, a), w, n_qp)
+                    for a in ("residual_closure", "normal_dissipation")})
     return FacetOutput(status=status, contact_fraction=contact_fraction,
                        slip_fraction=slip_fraction, area=w.reshape(-1, n_qp).sum(axis=1), **avg)
 
@@ -562,6 +584,7 @@ class InterfaceWriter:
 
     def _items(self, k: int, group: str, names: Sequence[str]) -> list:
         specs = self._specs[group]
+        names = list(names) + [n for n in MEMORY_FIELD_NAMES if n in specs]
         return [(n, f"/Step_{k + 1:04d}/{group}/{n}", specs[n]) for n in names]
 
     # ------------------------------------------------------------------ steps
@@ -586,11 +609,16 @@ class InterfaceWriter:
         facet_arrays = {name: getattr(fo, attr) for attr, name in _FIELDS}
         facet_arrays["contact_fraction"] = fo.contact_fraction
         facet_arrays["slip_fraction"] = fo.slip_fraction
+        memory = po.normal_dissipation is not None
+        if memory:
+            facet_arrays.update({n: getattr(fo, a) for a, n in _MEMORY if a != "h_min"})
         facet_arrays = _gather_rows(self.comm, facet_arrays)
         point_arrays = None
         if self.points:
             point_arrays = {name: getattr(po, attr) for attr, name in _FIELDS}
             point_arrays["weight_mm2"] = po.weight
+            if memory:
+                point_arrays.update({n: getattr(po, a) for a, n in _MEMORY})
             point_arrays = _gather_rows(self.comm, point_arrays)
         k = len(self.times)
 

@@ -137,6 +137,8 @@ _CSV_COLUMNS = [
     ("newton_its_spent", "newton_total"), ("linear_its", "linear_iterations"),
     ("linear_its_spent", "linear_total"), ("failed_attempts", "failed_attempts"),
     ("al_updates", "augmentations"),
+    ("normal_dissipation_Nmm", "normal_dissipation"),
+    ("normal_dissipation_step_Nmm", "normal_dissipation_step"),
 ]
 
 

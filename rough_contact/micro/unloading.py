@@ -175,14 +175,18 @@ def summit_unloading(omega, omega_max, kappa_m, e1, material: AsperityMaterial,
 
 
 # ---------------------------------------------------------------------------------------------
-# population sums (the table's model): shape nodes of population._outer_nodes, inner
-# Gauss-Legendre over the summit height with the edges of the unloading law as panel ends
+# population sums (the table's model)
 # ---------------------------------------------------------------------------------------------
+_SCAN = 24            # scan points per zeta node that locate the curvature window
+_SCAN_T = 6           # height nodes per half-panel of the scan
+_LOG_CUT = 34.0       # windows keep the integrand above exp(-34) of its maximum
+
+
 def _invert_delta_e(tau, tc, tp, kappa, f1, f2, f3, wc, wp, mat, smu, n_iter=48):
     """Smallest t2 >= tc with delta_e(smu t2) >= smu tau on the ZMC/plastic branch (t units).
 
     delta_e is increasing on [omega_c, inf) (checked in the tests); plastic branch in closed
-    form (delta_e = C sqrt(W)), the ZMC branch by bisection.
+    form (delta_e = C sqrt(W)), the ZMC branch by bisection (only where it is needed).
     """
     Es = mat.E_star
     # plastic: delta_e = 1.5 ch H A/S(A) = C_p sqrt(W)
@@ -193,71 +197,201 @@ def _invert_delta_e(tau, tc, tp, kappa, f1, f2, f3, wc, wp, mat, smu, n_iter=48)
     dep = _delta_e(wp, Ap, Pp, f1, f2, Es)
     Ac, Pc, _ = _loading(wc * (1 + 1e-12), kappa, f1, f2, f3, wc, wp, mat)
     dec = _delta_e(wc, Ac, Pc, f1, f2, Es)
-    lo = np.broadcast_to(tc, np.broadcast(tau, tc).shape).copy()
-    hi = np.broadcast_to(tp, lo.shape).copy()
-    for _ in range(n_iter):
-        mid = 0.5 * (lo + hi)
-        A, P, _ = _loading(smu * mid, kappa, f1, f2, f3, wc, wp, mat)
-        up = _delta_e(smu * mid, A, P, f1, f2, Es) < smu * tau
-        lo = np.where(up, mid, lo)
-        hi = np.where(up, hi, mid)
-    t2 = np.where(smu * tau <= dec, tc, np.where(smu * tau >= dep, np.maximum(tpl, tp), hi))
-    return t2
+    shape = np.broadcast(tau, tc).shape
+    hi = np.broadcast_to(tp, shape).copy()
+    zmc = (smu * tau > dec) & (smu * tau < dep)
+    if zmc.any():
+        Z = lambda x: np.broadcast_to(x, shape)[zmc]   # noqa: E731
+        ka, g1, g2, g3, c, p_, ta = Z(kappa), Z(f1), Z(f2), Z(f3), Z(wc), Z(wp), Z(tau)
+        lo_, hi_ = Z(tc).copy(), Z(tp).copy()
+        for _ in range(n_iter):
+            mid = 0.5 * (lo_ + hi_)
+            A, P, _ = _loading(smu * mid, ka, g1, g2, g3, c, p_, mat)
+            up = _delta_e(smu * mid, A, P, g1, g2, Es) < smu * ta
+            lo_ = np.where(up, mid, lo_)
+            hi_ = np.where(up, hi_, mid)
+        hi[zmc] = hi_
+    return np.where(smu * tau <= dec, tc, np.where(smu * tau >= dep, np.maximum(tpl, tp), hi))
 
 
-def _row_sums(surface, mat, h_min, u, n_quad, n_t):
-    """p, k, a, -da/dh at (h_min + u, h_min) for one h_min [mm] and an array u >= 0 [mm]."""
-    smu = math.sqrt(surface.m00 * surface.mu)
-    l = np.array([h_min / smu])
-    r4, r6, d, logw = _pop._outer_nodes(surface, l, n_quad, n_quad)
-    kappa, _, _, f1, f2, f3, KE = _pop._asperity_shape(surface, r4, r6, "exact", "exact")
-    keep = np.isfinite(logw) & (logw > np.max(logw) - 60.0)
-    S = lambda x: np.broadcast_to(x, logw.shape)[keep][None, :]   # noqa: E731  (1, n_s)
-    kappa, f1, f2, f3, KE = S(kappa), S(f1), S(f2), S(f3), S(KE)
-    dd = S(d[..., None])
-    ex = np.exp(S(logw))
+class _Coords:
+    """Shape coordinates of the unloading sums for one surface and material.
+
+    A summit's principal curvatures are kx = r4 sqrt(m40), ky = r6 sqrt(m04) (r = sqrt(mu) w,
+    w4, w6 the paper's normalised curvatures). The sums use K = kx + ky = 2 kappa_m [1/mm] and
+    zeta = ky/K in (0, 1): the axis ratio lambda^2 = kx/ky = (1 - zeta)/zeta, and so every
+    shape factor, depends on zeta alone, and at fixed zeta omega_c, delta_e(omega_c+) and
+    delta_e(omega_p) are all proportional to 1/K. The curvatures at which the unloading
+    integrand changes branch (omega_c = u, delta_e(omega_c+) = u, delta_e(omega_p) = u) are
+    therefore known in closed form on every zeta line and are made panel ends.
+    dr4 dr6 = K/(sqrt(m40) sqrt(m04)) dK dzeta.
+    """
+
+    def __init__(self, surface, mat):
+        self.s40, self.s04 = math.sqrt(surface.m40), math.sqrt(surface.m04)
+        self.sb1, self.sb2 = math.sqrt(surface.beta1), math.sqrt(surface.beta2)
+        self.smu = math.sqrt(surface.m00 * surface.mu)
+        self.rmu = math.sqrt(surface.mu)
+        self.surface, self.mat = surface, mat
+
+    def r(self, K, zeta):
+        return K * (1.0 - zeta) / self.s40, K * zeta / self.s04
+
+    def loading_window(self, l, zeta):
+        """[K_a, K_b] per zeta: the loading population's window (``population._p_windows``
+        along the zeta ray, whose integrand has the same -p^2/2 + 3 ln p + ln F_1 bound)."""
+        a = np.hypot((1.0 - zeta) / self.s40, zeta / self.s04)
+        b = (self.sb1 * (1.0 - zeta) / self.s40 + self.sb2 * zeta / self.s04) / self.rmu
+        pa, pb = _pop._p_windows(np.full(zeta.shape, l), b / a)
+        return pa / a, pb / a
+
+
+def _node_integrals(C, l, tau, K, zeta, n_t):
+    """Height integrals at the shape nodes (K, zeta) times the shape density and Jacobian.
+
+    tau, K, zeta broadcastable arrays. Returns (P, dP, A, A/delta_e) of their broadcast shape,
+    per unit dK dzeta, without the summit density. Height t = loading interference at h_min
+    over sqrt(m00 mu); the summits touching at h = h_min + tau sqrt(m00 mu) are those with
+    delta_e(omega_max) > u: t > tau (elastic, t < t_c) or t > t2 (ZMC/plastic, t2 the inverse
+    of delta_e). Panels: elastic [tau, t_c], ZMC [t2, t_p], plastic [max(t2, t_p), t_hi], each
+    in v = sqrt(t - start) and split at the peak t = -d of the Gaussian; a panel is evaluated
+    only at the nodes where it is not empty.
+    """
+    mat, smu = C.mat, C.smu
+    tau, K, zeta = np.broadcast_arrays(tau, K, zeta)
+    shape = K.shape
+    tau, K, zeta = tau.ravel(), K.ravel(), zeta.ravel()
+    r4, r6 = C.r(K, zeta)
+    r4, r6 = np.maximum(r4, 1e-300), np.maximum(r6, 1e-300)
+    kappa, _, _, f1, f2, f3, KE = _pop._asperity_shape(C.surface, r4, r6, "exact", "exact")
     Es = mat.E_star
     wc = KE * (mat.yield_pressure / Es) ** 2 / kappa
     wp = mat.omega_p_ratio * wc
     tc, tp = wc / smu, wp / smu
-    tau = (np.asarray(u, float) / smu)[:, None]                       # (n_u, 1)
-    t_lo = np.maximum(0.0, -dd - 12.0)
+    dd = l - (C.sb1 * r4 + C.sb2 * r6) / C.rmu
+    with np.errstate(divide="ignore"):
+        pref = (np.log(r4 * r6 * K / (C.s40 * C.s04)) - 0.5 * (r4 * r4 + r6 * r6)
+                - 0.5 * math.log(2 * math.pi))
     t_hi = np.where(dd <= 0, -dd + 12.0, -dd + np.sqrt(dd * dd + 144.0))
-    tpk = -dd
     t2 = _invert_delta_e(tau, tc, tp, kappa, f1, f2, f3, wc, wp, mat, smu)
     x, w = _pop._gl01(n_t)
-    out = [np.zeros(tau.shape[0]) for _ in range(4)]
-    # panels: (start of sqrt substitution, panel lower, panel upper)
-    panels = [(tau, np.maximum(tau, t_lo), np.minimum(tc, t_hi)),            # elastic summits
-              (t2, np.maximum(t2, t_lo), np.minimum(tp, t_hi)),              # ZMC
-              (np.maximum(t2, tp), np.maximum(np.maximum(t2, tp), t_lo), t_hi)]  # plastic
-    for t0, a, b in panels:
-        b = np.maximum(a, b)
-        va, vb = np.sqrt(np.maximum(a - t0, 0.0)), np.sqrt(np.maximum(b - t0, 0.0))
-        vpk = np.clip(np.sqrt(np.maximum(tpk - t0, 0.0)), va, vb)
-        for lo, hi in ((va, vpk), (vpk, vb)):
+    out = [np.zeros(K.size) for _ in range(4)]
+    t2p = np.maximum(t2, tp)
+    for t0, b in ((tau, np.minimum(tc, t_hi)), (t2, np.minimum(tp, t_hi)), (t2p, t_hi)):
+        live = np.flatnonzero(b > t0)
+        if not live.size:
+            continue
+        T0, ta, ka, g1, g2, g3, c, q, dl, pr = (a.take(live) for a in (
+            t0, tau, kappa, f1, f2, f3, wc, wp, dd, pref))
+        vb = np.sqrt(b.take(live) - T0)
+        vpk = np.clip(np.sqrt(np.maximum(-dl - T0, 0.0)), 0.0, vb)
+        acc = [np.zeros(live.size) for _ in range(4)]
+        for lo, hi in ((0.0, vpk), (vpk, vb)):
             for j in range(n_t):
                 v = lo + (hi - lo) * x[j]
-                t = t0 + v * v
+                t = T0 + v * v
                 jac = 2.0 * v * (hi - lo) * w[j]
                 W = smu * t
-                A, P, _ = _loading(W, kappa, f1, f2, f3, wc, wp, mat)
-                de = np.where(W < wc, W, _delta_e(W, A, P, f1, f2, Es))
+                A, P, _ = _loading(W, ka, g1, g2, g3, c, q, mat)
+                de = np.where(W < c, W, _delta_e(W, A, P, g1, g2, Es))
                 with np.errstate(divide="ignore", invalid="ignore"):
-                    xi = np.clip(np.where(de > 0, 1.0 - smu * tau / de, 0.0), 0.0, 1.0)
-                    kk = np.where(de > 0, 1.5 * P * np.sqrt(xi) / de, 0.0)
-                g = ex * jac * np.exp(-0.5 * (t + dd) ** 2) / math.sqrt(2 * math.pi)
-                out[0] += np.sum(g * P * xi ** 1.5, axis=1)
-                out[1] += np.sum(g * kk, axis=1)
-                out[2] += np.sum(g * A * xi, axis=1)
-                with np.errstate(divide="ignore", invalid="ignore"):
-                    out[3] += np.sum(g * np.where((xi > 0) & (de > 0), A / de, 0.0), axis=1)
+                    xi = np.clip(np.where(de > 0, 1.0 - smu * ta / de, 0.0), 0.0, 1.0)
+                    ide = np.where((xi > 0) & (de > 0), 1.0 / de, 0.0)
+                g = jac * np.exp(pr - 0.5 * (t + dl) ** 2)
+                acc[0] += g * P * xi ** 1.5
+                acc[1] += g * 1.5 * P * np.sqrt(xi) * ide
+                acc[2] += g * A * xi
+                acc[3] += g * A * ide
+        for o, a in zip(out, acc):
+            o[live] += a
+    return [o.reshape(shape) for o in out]
+
+
+def _branch_curvatures(C, tau, zeta):
+    """K at which omega_c, delta_e(omega_c+), delta_e(omega_p) equal u = tau sqrt(m00 mu),
+    per zeta (each of them is c(zeta)/K)."""
+    mat, Es = C.mat, C.mat.E_star
+    K1 = np.ones(np.broadcast(tau, zeta).shape)
+    r4, r6 = C.r(K1, zeta)
+    kappa, _, _, f1, f2, f3, KE = _pop._asperity_shape(C.surface, r4, r6, "exact", "exact")
+    wc = KE * (mat.yield_pressure / Es) ** 2 / kappa               # at K = 1/mm
+    wp = mat.omega_p_ratio * wc
+    Ac, Pc, _ = _loading(wc * (1 + 1e-12), kappa, f1, f2, f3, wc, wp, mat)
+    Ap, Pp, _ = _loading(wp, kappa, f1, f2, f3, wc, wp, mat)
+    u = np.maximum(tau * C.smu, 1e-300)
+    return (wc / u, _delta_e(wc, Ac, Pc, f1, f2, Es) / u, _delta_e(wp, Ap, Pp, f1, f2, Es) / u)
+
+
+def _rule(n, a, b, mode):
+    """Gauss-Legendre on [a, b] (arrays (..., 1)); mode 'lo'/'hi' clusters the nodes at that
+    end by a cubic map (edge singularities of the shape factors), None: plain."""
+    u, w = _pop._gl01(n)
+    if mode == "lo":
+        s, ds = u ** 3, 3.0 * u * u
+    elif mode == "hi":
+        s, ds = 1.0 - (1.0 - u) ** 3, 3.0 * (1.0 - u) ** 2
+    else:
+        s, ds = u, np.ones_like(u)
+    return a + (b - a) * s, (b - a) * ds * w
+
+
+def _row_sums(surface, mat, h_min, u, n_quad, n_t):
+    """p, k, a, -da/dh at (h_min + u, h_min) for one h_min [mm] and an array u >= 0 [mm].
+
+    Outer rule in (zeta, K) (``_Coords``): zeta on (0, 1/2) and (1/2, 1) (the circular ray
+    splits them; n_quad nodes each, clustered at the wedge edges); per zeta node, K on the
+    window where the unloading integrand itself lives (a scan of ``_SCAN`` points inside the
+    loading window, keeping the integrand above exp(-_LOG_CUT) of its maximum on that line,
+    widened by one scan cell: at large u only tall, flat summits still touch, far from where
+    the loading integrand lives), cut at the three branch curvatures and at the scan's peak,
+    n_quad nodes per panel; height: ``_node_integrals`` (n_t nodes per half-panel).
+    """
+    C = _Coords(surface, mat)
+    l = h_min / C.smu
+    tau = (np.asarray(u, float) / C.smu)[:, None]                 # (n_u, 1)
+    n_u = tau.shape[0]
+    z, wz = zip(_rule(n_quad, np.zeros(1), np.full(1, 0.5), "lo"),
+                _rule(n_quad, np.full(1, 0.5), np.ones(1), "hi"))
+    zeta = np.concatenate(z)                                      # (2n,)
+    wz = np.concatenate(wz)
+    Ka, Kb = C.loading_window(l, zeta)
+    # scan: live K range per (tau, zeta)
+    s = (np.arange(_SCAN) + 0.5) / _SCAN
+    Ks = Ka[:, None] + (Kb - Ka)[:, None] * s                     # (2n, S)
+    vals = _node_integrals(C, l, tau, Ks.reshape(1, -1), np.repeat(zeta, _SCAN)[None, :],
+                           _SCAN_T)
+    live = np.zeros((n_u, zeta.size, _SCAN), bool)
+    peak = np.zeros((n_u, zeta.size))
+    for q, v in enumerate(vals):
+        v = v.reshape(n_u, zeta.size, _SCAN)
+        m = v.max(axis=2, keepdims=True)
+        live |= (v > 0) & (v >= m * math.exp(-_LOG_CUT))
+        if q == 0:
+            peak = np.take_along_axis(Ks[None], v.argmax(axis=2)[..., None], 2)[..., 0]
+    idx = np.arange(_SCAN)
+    first = np.where(live, idx, _SCAN).min(axis=2)
+    last = np.where(live, idx, -1).max(axis=2)
+    dK = (Kb - Ka) / _SCAN
+    none = last < first
+    K0 = np.where(none, Ka, np.maximum(Ka, Ka + dK * (first - 1)))
+    K1 = np.where(none, Kb, np.minimum(Kb, Ka + dK * (last + 2)))
+    Kc, Kd, Kp = _branch_curvatures(C, tau, zeta[None, :])         # (n_u, 2n)
+    cuts = np.sort(np.stack([K0, np.clip(Kc, K0, K1), np.clip(Kd, K0, K1),
+                             np.clip(Kp, K0, K1), np.clip(peak, K0, K1), K1], -1), -1)
+    a, b = cuts[..., :-1, None], cuts[..., 1:, None]               # (n_u, 2n, 5, 1)
+    Kn, wK = _rule(n_quad, a, b, None)                             # (n_u, 2n, 5, n)
+    Zn = np.broadcast_to(zeta[None, :, None, None], Kn.shape).ravel()
+    Tn = np.broadcast_to(tau[:, :, None, None], Kn.shape).ravel()
+    row = np.broadcast_to(np.arange(n_u)[:, None, None, None], Kn.shape).ravel()
+    wt = (wK * wz[None, :, None, None]).ravel()
+    use = np.flatnonzero(wt > 0)                     # empty panels (coinciding cuts) dropped
+    vals = _node_integrals(C, l, Tn[use], Kn.ravel()[use], Zn[use], n_t)
     Ds = surface.summit_density
-    return out[0] * Ds, out[1] * Ds, out[2] * Ds, out[3] * Ds
+    return tuple(np.bincount(row[use], v * wt[use], minlength=n_u) * Ds for v in vals)
 
 
-def population_unloading(surface, material: AsperityMaterial, h, h_min, n_quad: int = 12,
-                         n_t: int = 12):
+def population_unloading(surface, material: AsperityMaterial, h, h_min, n_quad: int = 16,
+                         n_t: int = 24):
     """Population sums p [MPa], k = -dp/dh at fixed h_min [MPa/mm], A/A0 [-] at (h, h_min).
 
     The direct (untabulated) model of :class:`HistoryNormalLaw`. h_min scalar [mm]; h array

@@ -45,7 +45,8 @@ from rough_contact.solver.snes import SNESSolver
 from rough_contact.validation import check_scalar
 
 __all__ = ["E", "NU", "TOTAL_FORCE", "MOMENTS_UM", "FRICTION_CASES", "HARDENING", "TABLE5",
-           "PLASTIC", "NORMAL_LAWS", "effective_modulus", "make_law", "advise_law", "write_advice", "PunchScene", "quarter_punch", "PunchModel",
+           "PLASTIC", "NORMAL_LAWS", "effective_modulus", "make_law", "advise_law",
+           "write_advice", "PunchScene", "quarter_punch", "PunchModel",
            "build", "point_data", "plot_slip_directions", "PunchResult", "run"]
 
 # Silence the INFO lines of the JIT compiler (setuptools resets the root logger's level).
@@ -67,6 +68,13 @@ TABLE5 = {"21-node": {"a": 0.2478, "b": 0.2540, "c": 0.0150},
           "28-node": {"a": 0.2114, "b": 0.1868, "c": 0.0162}}
 # Elasto-plastic asperity data of Figs 18-19 (used with --normal-law elasto-plastic)
 PLASTIC = dict(Y=2070.0, K_Y=1.62, psi=0.35, ch=0.967, omega_p_ratio=45.0)
+# Normal laws: the paper's reversible ones, and the same populations with memory of the
+# smallest separation (irreversible asperity plasticity: unloading and reloading on the
+# elastic branch of h_min; issue 23, docs/unloading.md). The elastic population with memory is
+# exactly the reversible elastic law.
+NORMAL_LAWS = ("elastic", "elasto-plastic", "greenwood_williamson", "elastic-memory",
+               "elasto-plastic-memory")
+MEMORY_RTOL = 1e-3   # accuracy of the elasto-plastic history table (its build: minutes)
 
 
 # ## Interface law
@@ -102,13 +110,20 @@ def make_law(comm, law="rough", case="b", normal_law="elastic", seating_pressure
 
             surface = SpectralMoments(**MOMENTS_UM, unit="um")
             E_star = effective_modulus(E, NU, E, NU)
+            material = AsperityMaterial(E_star=E_star, nu=NU, **PLASTIC)
             if normal_law == "elastic":
                 normal = NormalLaw.elastic(surface, E_star)
             elif normal_law == "greenwood_williamson":
                 normal = NormalLaw.greenwood_williamson(surface, E_star)
-            else:
-                normal = NormalLaw.elasto_plastic(
-                    surface, AsperityMaterial(E_star=E_star, nu=NU, **PLASTIC))
+            elif normal_law == "elasto-plastic":
+                normal = NormalLaw.elasto_plastic(surface, material)
+            else:   # with memory: the normal history h_min (docs/unloading.md)
+                from rough_contact.interface.history import HistoryNormalLaw
+                if normal_law == "elastic-memory":
+                    normal = HistoryNormalLaw.elastic(surface, E_star)
+                else:
+                    normal = HistoryNormalLaw.elasto_plastic(surface, material,
+                                                             rtol=MEMORY_RTOL, strict=False)
         normal = comm.bcast(normal, root=0)
     if case == "none":
         rough = InterfaceLaw(normal=normal)
@@ -121,9 +136,6 @@ def make_law(comm, law="rough", case="b", normal_law="elastic", seating_pressure
         rough = InterfaceLaw(normal=normal, tangential=TangentialStiffness(kt),
                              friction=friction)
     return rough.with_seating(seating_pressure), normal
-
-
-NORMAL_LAWS = ("elastic", "elasto-plastic", "greenwood_williamson")
 
 
 # ## The law advisor (``normal_law="auto"``)
@@ -446,6 +458,9 @@ def run(mesh_size=20.0, contact_size=2.0, order=2, load_half_width=2.5, steps=16
                         "in docs/punch.md: this is expected, not a failed run)", comm=comm)
     else:
         PETSc.Sys.Print(f"Total frictional dissipation D: {D:.4g} N mm", comm=comm)
+    if normal_law.endswith("-memory"):
+        PETSc.Sys.Print(f"Normal hysteresis (asperity plasticity, law with memory): "
+                        f"{interface.normal_dissipation():.4g} N mm", comm=comm)
     PETSc.Sys.Print(f"Output in {outdir}/ (displacement.xdmf, interface.xdmf, history.csv, "
                     f"slip_directions*.png); wall time {MPI.Wtime() - t0:.1f} s", comm=comm)
     assert max_force_error < 1e-6, f"force balance violated: {max_force_error:.3e}"

@@ -133,6 +133,9 @@ class Increment:
         contact_force: total interface force on the FIRST body (3,) [N] (zeros if unknown).
         real_area: real contact area [mm^2] (nan if unknown).
         dissipation: cumulative frictional dissipation [N mm] (nan if unknown).
+        normal_dissipation: cumulative normal hysteresis energy of a normal law with memory
+            [N mm] (0 for a reversible law, nan if unknown); ``normal_dissipation_step`` is
+            this step's part.
         cutbacks: halvings done before this step converged.
         newton_total: Newton iterations spent since the previous converged step: this one's
             plus those of every failed attempt in between (cutbacks).
@@ -172,6 +175,8 @@ class Increment:
     linear_total: int = 0
     failed_attempts: int = 0
     augmentations: int = 0
+    normal_dissipation: float = float("nan")
+    normal_dissipation_step: float = float("nan")
 
 
 def load_unload_factors(n_load: int, n_unload: Optional[int] = None,
@@ -323,6 +328,7 @@ class _Stepper:
         self.step = 0
         self.spent = [0, 0, 0]  # Newton its, linear its, failed attempts since the last step
         self.carried = None     # (3,) interface force of the last converged increment [N]
+        self.normal_dissipated = 0.0   # committed normal hysteresis [N mm] at the last step
 
     def run(self, *, checkpoint, resume, outputs, max_steps) -> Iterator[Increment]:
         problem = self.problem
@@ -340,6 +346,8 @@ class _Stepper:
             if restored.u_previous is not None:
                 self.u_previous = self.u_committed.duplicate()
                 self.u_previous.setArray(restored.u_previous)
+        if self.interface is not None:   # the baseline of Increment.normal_dissipation_step
+            self.normal_dissipated = self.interface.normal_dissipation()
         done = 0
         for i, target in enumerate(self.factors):
             if i < start_index:
@@ -420,6 +428,9 @@ class _Stepper:
             inc.dissipation = s.dissipation
             inc.n_beyond_validity = s.n_beyond_validity
             self.carried = np.array(s.contact_force, dtype=float)
+            inc.normal_dissipation = s.normal_dissipation
+            inc.normal_dissipation_step = s.normal_dissipation - self.normal_dissipated
+            self.normal_dissipated = s.normal_dissipation
         saved = None
         if checkpoint is not None:   # written after the caller's loop body
             saved = CheckpointState(
