@@ -83,7 +83,7 @@ class PointFields:
         contact: (n,) bool.
         slipping: (n,) bool, in contact and slipping.
         weight: (n,) quadrature weight = area represented by the point [mm^2].
-        h_min, residual_closure, normal_dissipation: only for a normal law with memory
+        h_min, max_closure, normal_dissipation: only for a normal law with memory
             (state ``HistoryInterfaceState``), else None: (n,) smallest mean-plane separation
             reached (committed; +inf where virgin) [mm]; h0 - h_min, the largest closure
             reached, which the unloading branch remembers (0 where virgin) [mm]; committed
@@ -101,7 +101,7 @@ class PointFields:
     slipping: np.ndarray
     weight: np.ndarray
     h_min: Optional[np.ndarray] = None
-    residual_closure: Optional[np.ndarray] = None
+    max_closure: Optional[np.ndarray] = None
     normal_dissipation: Optional[np.ndarray] = None
 
 
@@ -226,7 +226,7 @@ class InterfaceQueries:
                                                 self.paired.weights)), op=MPI.SUM)
 
     def _memory_fields(self) -> dict:
-        """h_min, residual closure and normal dissipation per point (PointFields), empty for a
+        """h_min, largest closure and normal dissipation per point (PointFields), empty for a
         law without normal memory."""
         committed = self.history.law.committed
         if not isinstance(committed, HistoryInterfaceState):
@@ -235,7 +235,7 @@ class InterfaceQueries:
         h0 = self.law.h0 if isinstance(self.law, InterfaceLaw) else None
         closure = (np.zeros_like(h_min) if h0 is None
                    else np.where(np.isfinite(h_min), np.maximum(float(h0) - h_min, 0.0), 0.0))
-        return {"h_min": h_min, "residual_closure": closure,
+        return {"h_min": h_min, "max_closure": closure,
                 "normal_dissipation": self.history.law.normal_dissipated.copy()}
 
 

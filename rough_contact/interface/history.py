@@ -140,7 +140,7 @@ class HistoryNormalLaw:
     _D: Optional[np.ndarray] = None     # (n_m + 1,) D(h_min) at the rows [N/mm]
     _dD: Optional[np.ndarray] = None    # (n_m + 1,) dD/dh_min at the rows (monotone slopes)
     _IL: float = 0.0                    # int exp(rho(row 0, x)) dx incl. taper [-]
-    info: dict = field(default_factory=dict)
+    info: dict = field(default_factory=dict, compare=False)   # build statistics, not identity
 
     # ------------------------------------------------------------ NormalLaw interface
     @property

@@ -137,7 +137,7 @@ class PointOutput(_InterfaceFields):
         dissipation: (n,) accumulated frictional dissipation per area [N/mm] (= mJ/mm^2).
         status: (n,) int32, 0 open, 1 stick, 2 slip.
         weight: (n,) area represented by the point [mm^2].
-        h_min, residual_closure, normal_dissipation: (n,) only for a normal law with memory
+        h_min, max_closure, normal_dissipation: (n,) only for a normal law with memory
             (else None): smallest separation reached [mm] (NaN where virgin), the largest
             closure reached h0 - h_min [mm], accumulated normal hysteresis energy per area
             [N/mm]; written as ``MEMORY_FIELD_NAMES``.
@@ -145,7 +145,7 @@ class PointOutput(_InterfaceFields):
 
     weight: np.ndarray
     h_min: Optional[np.ndarray] = None
-    residual_closure: Optional[np.ndarray] = None
+    max_closure: Optional[np.ndarray] = None
     normal_dissipation: Optional[np.ndarray] = None
 
 
@@ -160,14 +160,14 @@ class FacetOutput(_InterfaceFields):
         contact_fraction: (n_f,) part of the facet's area in contact [-].
         slip_fraction: (n_f,) part of the facet's area slipping [-].
         area: (n_f,) facet area, sum of its quadrature weights [mm^2].
-        residual_closure, normal_dissipation: (n_f,) averages (normal law with memory only,
+        max_closure, normal_dissipation: (n_f,) averages (normal law with memory only,
             else None).
     """
 
     contact_fraction: np.ndarray
     slip_fraction: np.ndarray
     area: np.ndarray
-    residual_closure: Optional[np.ndarray] = None
+    max_closure: Optional[np.ndarray] = None
     normal_dissipation: Optional[np.ndarray] = None
 
 
@@ -181,7 +181,7 @@ _FIELDS = (
 FACET_FIELD_NAMES = tuple(n for _, n in _FIELDS) + ("contact_fraction", "slip_fraction")
 POINT_FIELD_NAMES = tuple(n for _, n in _FIELDS) + ("weight_mm2",)
 # written besides, only when the normal law has memory (h_min at the points only)
-_MEMORY = (("residual_closure", "residual_closure_mm"),
+_MEMORY = (("max_closure", "max_closure_mm"),
            ("normal_dissipation", "normal_dissipation_N_per_mm"), ("h_min", "h_min_mm"))
 MEMORY_FIELD_NAMES = tuple(n for _, n in _MEMORY)
 
@@ -271,7 +271,7 @@ def point_output(interface: InterfaceOutputSource) -> PointOutput:
         weight=np.asarray(pf.weight, dtype=float),
         **({} if pf.normal_dissipation is None else {
             "h_min": np.where(np.isfinite(pf.h_min), pf.h_min, np.nan).astype(float),
-            "residual_closure": np.asarray(pf.residual_closure, dtype=float),
+            "max_closure": np.asarray(pf.max_closure, dtype=float),
             "normal_dissipation": np.asarray(pf.normal_dissipation, dtype=float)}),
     )
 
@@ -287,7 +287,7 @@ def facet_output(interface: InterfaceOutputSource,
            for attr, _ in _FIELDS if attr != "status"}
     if po.normal_dissipation is not None:
         avg.update({a: facet_average(getattr(po, a), w, n_qp)
-                    for a in ("residual_closure", "normal_dissipation")})
+                    for a in ("max_closure", "normal_dissipation")})
     return FacetOutput(status=status, contact_fraction=contact_fraction,
                        slip_fraction=slip_fraction, area=w.reshape(-1, n_qp).sum(axis=1), **avg)
 

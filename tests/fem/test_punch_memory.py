@@ -104,13 +104,13 @@ def test_memory_punch_settles_dissipates_and_does_not_depend_on_rank_count(tmp_p
     # point fields and the interface XDMF output carry the memory
     pf = ci.point_fields()
     np.testing.assert_array_equal(pf.h_min, h_min)
-    assert np.all(pf.residual_closure >= 0.0) and np.all(pf.normal_dissipation >= 0.0)
+    assert np.all(pf.max_closure >= 0.0) and np.all(pf.normal_dissipation >= 0.0)
     if comm.rank == 0:
         with h5py.File(f"{outdir}/interface.h5", "r") as f:
             last = sorted(k for k in f if k.startswith("Step_"))[-1]
             assert set(MEMORY_FIELD_NAMES) <= set(f[last]["points"])
             assert set(f[last]["points"]) == set(POINT_FIELD_NAMES) | set(MEMORY_FIELD_NAMES)
-            assert np.nanmax(f[last]["points"]["residual_closure_mm"][...]) > 0.0
+            assert np.nanmax(f[last]["points"]["max_closure_mm"][...]) > 0.0
     # one rank (COMM_SELF, the whole mesh) = this run's rank count
     m1, incs1, gaps1 = _run(MPI.COMM_SELF, MemoryLaw())
     np.testing.assert_allclose(m1.interface.normal_dissipation(), Dn, rtol=1e-10)
