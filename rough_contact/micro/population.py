@@ -179,12 +179,14 @@ def _p_windows(l, k):
     window is where log G > max log G - 50; concavity with the -p^2/2 term bounds it to
     mode +- 10.
     """
-    l2 = np.concatenate([l, l])
+    l = np.asarray(l, dtype=float)
+    k = np.broadcast_to(np.asarray(k, dtype=float), l.shape)   # a scalar or one per l
+    l2, k2 = np.concatenate([l, l]), np.concatenate([k, k])
 
     def logG(p):
-        ll = l if p.size == l.size else l2
+        ll, kk = (l, k) if p.size == l.size else (l2, k2)
         p = np.maximum(p, 1e-300)
-        return -0.5 * p * p + 3.0 * np.log(p) + log_F_n(1.0, ll - k * p)
+        return -0.5 * p * p + 3.0 * np.log(p) + log_F_n(1.0, ll - kk * p)
 
     # Both points of a golden-section step, and both edges of the window, go through one call
     # of logG (elementwise: the same numbers as separate calls, at half the calls; the fixed
