@@ -37,6 +37,9 @@ the stiffness k and the real-area fraction A/A0 at equal pressure, the interface
 h(p_min) - h(p) (what a seated interface closes between the lightest and the given load), and,
 for information, the pressure at equal separation (seating removes a uniform shift of ln p, so
 the FE results do not see it). Each is the largest relative difference over the range.
+``results`` selects which of them the tolerance holds (force ~ k, area, approach) and may add the
+frictional dissipation, estimated as ``DISSIPATION_AMPLIFICATION`` times the k difference (partial
+slip amplifies it; measured on the punch, ``docs/advisor.md``).
 
 The estimates: the population sums (``rough_contact.micro.population``) at a handful of
 separations spanning the range, with coarse quadrature (elastic n_quad = 16; elasto-plastic
