@@ -21,7 +21,11 @@ its ratio to the cheapest table build of the same surface (the elastic anisotrop
 cheapest one that needs the population integral; McCool's GW table is a closed form).
 
     OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bench_advisor.py [--tolerance 0.05]
-        [--surfaces ...] [--scenes punch beam] [--csv FILE]
+        [--surfaces ...] [--scenes punch beam] [--csv FILE] [--results ...] [--cost-only]
+
+``--cost-only`` skips the FE runs and prints only the advisor's own cost against the elastic
+table's build of the same surface and modulus (each the fastest of ``--repeat`` interleaved
+runs, so that a busy machine slows both alike).
 
 Units: mm, N, MPa.
 """
@@ -41,7 +45,7 @@ petsc4py.init(sys.argv)
 import numpy as np  # noqa: E402
 from mpi4py import MPI  # noqa: E402
 
-from rough_contact.advisor import advise, scene_pressure_range  # noqa: E402
+from rough_contact.advisor import RESULTS_ALL, advise, scene_pressure_range  # noqa: E402
 from rough_contact.interface.normal import NormalLaw  # noqa: E402
 from rough_contact.micro.asperity import AsperityMaterial  # noqa: E402
 from rough_contact.scenes import beam, flat_punch  # noqa: E402
@@ -126,6 +130,36 @@ def compare(full, adv):
                 approach=rel(adv["approach"], full["approach"]))
 
 
+def cost_only(cases, scenes, tolerance, results, repeat):
+    """Advisor wall time / elastic table build, per surface and scene (no FE run)."""
+    rows = []
+    for name, (surface, mdata) in cases:
+        for scene, (E, nu, p_range) in scenes.items():
+            material = AsperityMaterial(E_star=E, nu=nu, **mdata)
+            t_adv, t_el = [], []
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", UserWarning)
+                advise(surface, material, p_range, tolerance, results=results)   # warm-up
+                for _ in range(repeat):
+                    t = time.perf_counter()
+                    advice = advise(surface, material, p_range, tolerance, results=results)
+                    t_adv.append(time.perf_counter() - t)
+                    t = time.perf_counter()
+                    NormalLaw.elastic(surface, E)
+                    t_el.append(time.perf_counter() - t)
+            rows.append(dict(surface=name, scene=scene, advised=advice.normal,
+                             advisor=min(t_adv), elastic_build=min(t_el),
+                             advisor_ratio=min(t_adv) / min(t_el)))
+            print(f"-> {rows[-1]}", flush=True)
+    print("\n| surface | scene | advised | advisor [ms] | elastic table build [s] "
+          "| advisor / build |")
+    print("|---|---|---|---|---|---|")
+    for r in rows:
+        print(f"| {r['surface']} | {r['scene']} | {r['advised']} | {r['advisor'] * 1e3:.0f} "
+              f"| {r['elastic_build']:.2f} | {r['advisor_ratio']:.1%} |")
+    return rows
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0], allow_abbrev=False)
     ap.add_argument("--tolerance", type=float, default=0.05)
@@ -133,13 +167,18 @@ def main(argv=None):
                     help="indices (0-5) of the surfaces to run (default all)")
     ap.add_argument("--scenes", nargs="+", default=["punch", "beam"], choices=["punch", "beam"])
     ap.add_argument("--csv", default=None)
+    ap.add_argument("--results", nargs="+", default=list(RESULTS_ALL),
+                    choices=list(RESULTS_ALL),
+                    help="the FE results the advice must keep within the tolerance (default "
+                         "all, as the demos' --law auto: the table reports each)")
+    ap.add_argument("--cost-only", action="store_true",
+                    help="only the advisor's cost against the elastic table build (no FE)")
+    ap.add_argument("--repeat", type=int, default=3, help="--cost-only: runs of each timing")
     args, _ = ap.parse_known_args(argv)
     comm = MPI.COMM_WORLD
     cases = list(surfaces().items())
     if args.surfaces is not None:
         cases = [cases[i] for i in args.surfaces]
-    setup = beam.build_scene(comm, mesh_size=80.0, contact_size=20.0, order=1) \
-        if "beam" in args.scenes else None
     E_punch = flat_punch.effective_modulus(flat_punch.E, flat_punch.NU, flat_punch.E,
                                            flat_punch.NU)
     scenes = {"punch": (E_punch, flat_punch.NU,
@@ -148,6 +187,15 @@ def main(argv=None):
                        scene_pressure_range(beam.TOTAL_FORCE / 2, 2500.0,
                                             beam.INITIAL_FORCE / 2 / 2500.0,
                                             beam.PRESSURE_CONCENTRATION))}
+    scenes = {k: v for k, v in scenes.items() if k in args.scenes}
+    results = tuple(args.results)
+    if args.cost_only:
+        rows = cost_only(cases, scenes, args.tolerance, results, args.repeat)
+        if args.csv:
+            write_csv(args.csv, rows)
+        return
+    setup = beam.build_scene(comm, mesh_size=80.0, contact_size=20.0, order=1) \
+        if "beam" in args.scenes else None
     rows = []
     for name, (surface, mdata) in cases:
         for scene in args.scenes:
@@ -155,7 +203,7 @@ def main(argv=None):
             material = AsperityMaterial(E_star=E, nu=nu, **mdata)
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", UserWarning)
-                advice = advise(surface, material, p_range, args.tolerance)
+                advice = advise(surface, material, p_range, args.tolerance, results=results)
                 t = time.perf_counter()
                 NormalLaw.elastic(surface, E)
                 t_el = time.perf_counter() - t

@@ -87,7 +87,7 @@ def parse_args(argv):
                         "advice.json; docs/advisor.md)")
     parser.add_argument("--tolerance", type=float, default=0.05,
                         help="--law auto: accepted relative difference from the full model in "
-                        "k, A/A0 and interface approach")
+                        "k, A/A0, interface approach and frictional dissipation (docs/advisor.md)")
     parser.add_argument("--outdir", default="results/beam")
     parser.add_argument("--figdir", default=None, help="also copy the figures here "
                         "(e.g. docs/figures)")

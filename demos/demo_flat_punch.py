@@ -68,7 +68,7 @@ def parse_args(argv):
                         "OUTDIR/advice.txt, advice.json; docs/advisor.md)")
     parser.add_argument("--tolerance", type=float, default=0.05,
                         help="--law auto: accepted relative difference from the full model in "
-                        "k, A/A0 and interface approach")
+                        "k, A/A0, interface approach and frictional dissipation (docs/advisor.md)")
     parser.add_argument("--case", default="b", choices=["a", "b", "c", "none"],
                         help="friction case of Fig 18")
     parser.add_argument("--normal-law", default="elasto-plastic",

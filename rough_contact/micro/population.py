@@ -130,6 +130,23 @@ def log_F_n(n: float, d):
     return out
 
 
+def _log_F1_closed(d):
+    """log F_1(d) = log(phi(d) - d Q(d)) in closed form (erfcx), for the window search:
+    F_1 = exp(-d^2/2) (1/sqrt(2 pi) - d/2 erfcx(d/sqrt 2)); the bracket loses ~d^2 eps
+    to cancellation for d > 0 (1e-12 at d = 30), and d > 60 takes the asymptotic
+    phi(d)/d^2 (1 - 3/d^2 + 15/d^4). ~5x cheaper than :func:`log_F_n` (pbdv)."""
+    d = np.asarray(d, float)
+    big = d > 60.0
+    ds = np.where(big, 0.0, d)
+    c = 1.0 / math.sqrt(2.0 * math.pi)
+    with np.errstate(divide="ignore"):
+        core = np.log(np.maximum(c - 0.5 * ds * special.erfcx(ds / math.sqrt(2.0)), 1e-300))
+        x2 = 1.0 / np.where(big, d * d, 1.0)
+        asym = (math.log(c) - 2.0 * np.log(np.where(big, d, 1.0))
+                + np.log1p(-3.0 * x2 + 15.0 * x2 * x2))
+    return np.where(big, asym, core) - 0.5 * d * d
+
+
 def F_n(n: float, d):
     """F_n(d) = int_0^inf t^n phi(t + d) dt (underflows to 0 for d > ~38)."""
     return np.exp(log_F_n(n, d))
@@ -171,8 +188,13 @@ def _gl01(n):
 # Outer (p, q) quadrature
 # ---------------------------------------------------------------------------------------
 
-def _p_windows(l, k):
+def _p_windows(l, k, window_tol=0.0):
     """Integration window [pa, pb] in p for each l (vectorised log-concave search).
+
+    ``window_tol`` > 0 stops the mode search and the edge bisection once every bracket is
+    narrower than it (in p, a standard-normal variable); 0 (default): to the fixed point of
+    the iteration. An edge off by 1e-3 moves log G there by ~1e-2 at a level 50 below the
+    peak: the window's content is unchanged, only the quadrature nodes shift.
 
     log G(p) = -p^2/2 + 3 ln p + ln F_1(l - k p) is concave in p > 0 (F_1 is log-concave),
     a bound on the shape of the integrand (the q-integral grows at most like p^3). The
@@ -183,10 +205,12 @@ def _p_windows(l, k):
     k = np.broadcast_to(np.asarray(k, dtype=float), l.shape)   # a scalar or one per l
     l2, k2 = np.concatenate([l, l]), np.concatenate([k, k])
 
+    log_F1 = (lambda d: log_F_n(1.0, d)) if window_tol <= 0.0 else _log_F1_closed
+
     def logG(p):
         ll, kk = (l, k) if p.size == l.size else (l2, k2)
         p = np.maximum(p, 1e-300)
-        return -0.5 * p * p + 3.0 * np.log(p) + log_F_n(1.0, ll - kk * p)
+        return -0.5 * p * p + 3.0 * np.log(p) + log_F1(ll - kk * p)
 
     # Both points of a golden-section step, and both edges of the window, go through one call
     # of logG (elementwise: the same numbers as separate calls, at half the calls; the fixed
@@ -196,6 +220,8 @@ def _p_windows(l, k):
     b = np.maximum(l, 0.0) / k + 6.0      # the mode lies below p_l + 3
     g = (math.sqrt(5.0) - 1.0) / 2.0
     for _ in range(100):                   # golden-section search of the mode
+        if window_tol > 0.0 and np.max(b - a) < window_tol:
+            break
         c = b - g * (b - a)
         e = a + g * (b - a)
         G = logG(np.concatenate([c, e]))
@@ -213,6 +239,8 @@ def _p_windows(l, k):
     hi = np.concatenate([pm, pm + half])
     lower = np.arange(2 * n) < n
     for _ in range(60):
+        if window_tol > 0.0 and np.max(hi - lo) < window_tol:
+            break
         mid = 0.5 * (lo + hi)
         above = logG(mid) > target
         # the lower edge moves down while above the target, the upper edge up
@@ -222,10 +250,15 @@ def _p_windows(l, k):
         if np.array_equal(lo_new, lo) and np.array_equal(hi_new, hi):
             break
         lo, hi = lo_new, hi_new
+    if window_tol > 0.0:
+        # the brackets' midpoints: a lower edge bracketed by [0, window_tol) must not fall on
+        # p = 0 (zero curvature, where the elasto-plastic boundary term is 0 * inf)
+        mid = 0.5 * (lo + hi)
+        return mid[:n], mid[n:]
     return lo[:n], hi[n:]
 
 
-def _outer_nodes(surface: SpectralMoments, l, n_quad, n_p=None):
+def _outer_nodes(surface: SpectralMoments, l, n_quad, n_p=None, window_tol=0.0):
     """Nodes and weights of the (p, q) rule for each separation.
 
     Returns arrays of shape (n_h, n_p, n_q): r4, r6, d (= l - k p), log of the Gaussian
@@ -235,7 +268,7 @@ def _outer_nodes(surface: SpectralMoments, l, n_quad, n_p=None):
     B = b1 + b2
     sb1, sb2, sB = math.sqrt(b1), math.sqrt(b2), math.sqrt(B)
     k = sB / math.sqrt(mu)
-    pa, pb = _p_windows(l, k)
+    pa, pb = _p_windows(l, k, window_tol)
     # p panels split at d = +-12 (p = (l -+ 12)/k)
     cuts = np.stack([pa, np.clip((l - _D_SPLIT) / k, pa, pb), np.clip((l + _D_SPLIT) / k, pa, pb), pb],
                     axis=-1)
@@ -301,7 +334,8 @@ def _chunks(n_h, per_h, budget=1_500_000):
 # ---------------------------------------------------------------------------------------
 
 def elastic(surface: SpectralMoments, E_star: float, h, n_quad: int = 32,
-            elliptic: str = "exact", eccentricity: str = "exact") -> PopulationResult:
+            elliptic: str = "exact", eccentricity: str = "exact",
+            window_tol: float = 0.0) -> PopulationResult:
     """Elastic anisotropic population, eqs (52), (53), (55).
 
     Args:
@@ -311,6 +345,9 @@ def elastic(surface: SpectralMoments, E_star: float, h, n_quad: int = 32,
         n_quad: Gauss-Legendre nodes per panel (see module docstring for accuracy).
         elliptic: "exact" or "as" (A&S (36)-(39)) for K, E in f1, f2.
         eccentricity: "exact" (inversion of (27)) or "paper" (eq (33), clipped).
+        window_tol: > 0 ends the search of the p window at that bracket width (a cheaper
+            search for coarse estimates, e.g. 1e-3 in ``rough_contact.advisor``); 0: to the
+            fixed point (see ``_p_windows``).
     Returns:
         PopulationResult (area_fraction, pressure [MPa], stiffness [MPa/mm]) shaped like h.
     """
@@ -322,7 +359,7 @@ def elastic(surface: SpectralMoments, E_star: float, h, n_quad: int = 32,
     Kn = np.zeros(l.size)
     per_h = 3 * n_quad * 3 * n_quad
     for sl in _chunks(l.size, per_h):
-        r4, r6, d, logw = _outer_nodes(surface, l[sl], n_quad)
+        r4, r6, d, logw = _outer_nodes(surface, l[sl], n_quad, window_tol=window_tol)
         kappa, _, _, f1, f2, _, _ = _asperity_shape(surface, r4, r6, elliptic, eccentricity)
         F1 = log_F_n(1.0, d)[..., None]
         F32 = log_F_n(1.5, d)[..., None]
@@ -364,21 +401,24 @@ def elasto_plastic(surface: SpectralMoments, material: AsperityMaterial, h, n_qu
 
 
 def elasto_plastic_and_elastic(surface: SpectralMoments, material: AsperityMaterial, h,
-                               n_quad: int = 24, n_t: int | None = None):
+                               n_quad: int = 24, n_t: int | None = None,
+                               window_tol: float = 0.0):
     """The elasto-plastic sums and the purely elastic ones on the same quadrature nodes.
 
     The elastic result uses the elasto-plastic quadrature (inner t rule instead of the closed
     forms of :func:`elastic`): with a coarse rule both carry nearly the same quadrature error,
     which cancels in their ratio (what ``rough_contact.advisor`` compares). Arguments as in
-    :func:`elasto_plastic`.
+    :func:`elasto_plastic`; ``window_tol`` as in :func:`elastic`.
 
     Returns:
         (elasto-plastic PopulationResult, elastic PopulationResult).
     """
-    return _elasto_plastic(surface, material, h, n_quad, "exact", "exact", n_t, True)
+    return _elasto_plastic(surface, material, h, n_quad, "exact", "exact", n_t, True,
+                           window_tol)
 
 
-def _elasto_plastic(surface, material, h, n_quad, elliptic, eccentricity, n_t, elastic_too):
+def _elasto_plastic(surface, material, h, n_quad, elliptic, eccentricity, n_t, elastic_too,
+                    window_tol=0.0):
     mat = material.resolve(surface)
     n_quad = _check_nquad(n_quad)
     shape, l, smu, Ds = _separations(surface, h)
@@ -394,7 +434,7 @@ def _elasto_plastic(surface, material, h, n_quad, elliptic, eccentricity, n_t, e
     n_p = (3 * n_quad) // 2
     per_h = 3 * n_p * 3 * n_quad * 4 * n_t
     for sl in _chunks(l.size, per_h, budget=1_000_000):
-        r4, r6, d, logw = _outer_nodes(surface, l[sl], n_quad, n_p)
+        r4, r6, d, logw = _outer_nodes(surface, l[sl], n_quad, n_p, window_tol)
         kappa, _, _, f1, f2, f3, KE = _asperity_shape(surface, r4, r6, elliptic, eccentricity)
         wc = KE * (pY / Es) ** 2 / kappa          # (65) [mm]
         wp = R * wc

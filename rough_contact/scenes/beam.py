@@ -114,15 +114,18 @@ def beam_material(hardness="psi", m00=None):
 PRESSURE_CONCENTRATION = 10.0
 
 
-def advise_normal_law(comm, m00, hardness="psi", tolerance=0.05, surface=None, material=None):
+def advise_normal_law(comm, m00, hardness="psi", tolerance=0.05, surface=None, material=None,
+                      results=None):
     """The law advisor's choice for the beam on Table 4's surface with variance m00 [um^2]
     (nominal pressures from the seating pressure to PRESSURE_CONCENTRATION times the mean of
     the full load) and the advised NormalLaw (rank 0 builds it). Collective.
+    ``results``: the FE results held within ``tolerance`` (``rough_contact.advisor.RESULTS_ALL``
+    by default: the run reports the frictional dissipation too).
 
     Returns ``(advice, normal)``, the same on every rank."""
     advice = normal = None
     if comm.rank == 0:
-        from rough_contact.advisor import advise, scene_pressure_range
+        from rough_contact.advisor import RESULTS_ALL, advise, scene_pressure_range
         from rough_contact.surface import SpectralMoments
 
         surface = surface or SpectralMoments(m00=m00, **MOMENTS_UM, unit="um")
@@ -130,7 +133,8 @@ def advise_normal_law(comm, m00, hardness="psi", tolerance=0.05, surface=None, m
         area = 10.0 * 250.0          # half model's contact face [mm^2] (meshes/beam: 10 x 500)
         p_range = scene_pressure_range(TOTAL_FORCE / 2.0, area, INITIAL_FORCE / 2.0 / area,
                                        PRESSURE_CONCENTRATION)
-        advice = advise(surface, material, p_range, tolerance)
+        advice = advise(surface, material, p_range, tolerance,
+                        results=RESULTS_ALL if results is None else results)
         normal = advice.normal_law()
     return comm.bcast(advice, root=0), comm.bcast(normal, root=0)
 

@@ -144,12 +144,15 @@ def make_law(comm, law="rough", case="b", normal_law="elastic", seating_pressure
 # mean pressure under the punch (the pressure rises towards the punch's edges); the advisor
 # (rough_contact.advisor) picks the cheapest normal law within the tolerance over that range.
 def advise_law(comm, tolerance=0.05, steps=16, total_force=TOTAL_FORCE, half_width=10.0,
-               concentration=2.0, surface=None, material=None):
+               concentration=2.0, surface=None, material=None, results=None):
     """The advisor's choice for the punch, and the advised NormalLaw (built on rank 0, copied
-    to the others). Collective. Returns ``(advice, normal)``, the same on every rank."""
+    to the others). Collective. Returns ``(advice, normal)``, the same on every rank.
+
+    ``results``: the FE results held within ``tolerance`` (``rough_contact.advisor.RESULTS_ALL``
+    by default: the run reports the frictional dissipation too)."""
     advice = normal = None
     if comm.rank == 0:
-        from rough_contact.advisor import advise, scene_pressure_range
+        from rough_contact.advisor import RESULTS_ALL, advise, scene_pressure_range
         from rough_contact.micro.asperity import AsperityMaterial
         from rough_contact.surface import SpectralMoments
 
@@ -159,7 +162,8 @@ def advise_law(comm, tolerance=0.05, steps=16, total_force=TOTAL_FORCE, half_wid
         quarter = total_force / 4.0
         area = half_width ** 2
         p_range = scene_pressure_range(quarter, area, quarter / steps / area, concentration)
-        advice = advise(surface, material, p_range, tolerance)
+        advice = advise(surface, material, p_range, tolerance,
+                        results=RESULTS_ALL if results is None else results)
         normal = advice.normal_law()
     return comm.bcast(advice, root=0), comm.bcast(normal, root=0)
 

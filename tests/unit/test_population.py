@@ -191,3 +191,26 @@ def test_shapes_and_paper_options():
     assert np.all(np.isfinite(p.pressure))
     a = pop.elastic(S1, E_STAR, h, n_quad=12, elliptic="as")
     assert np.allclose(a.pressure, r.pressure, rtol=1e-3)
+
+
+def test_window_search_closed_form_F1_and_tolerance():
+    # the advisor's cheaper window search: log F_1 in closed form (erfcx) against the pbdv
+    # route of log_F_n, and the population sums with window_tol = 1e-3 against the default
+    # search to the fixed point (same window content: the coarse-quadrature sums agree far
+    # below their own ~1e-3 quadrature error)
+    d = np.linspace(-20.0, 200.0, 4001)
+    assert np.max(np.abs(pop._log_F1_closed(d) - pop.log_F_n(1.0, d))) < 1e-8
+    s = SpectralMoments(m00=0.625, m20=8e-5, m02=8e-4, m40=1.04e-6, m04=1.04e-4, unit="um")
+    h = np.linspace(-1.0, 4.0, 6) * s.rq
+    a = pop.elastic(s, 1e5, h, n_quad=16)
+    b = pop.elastic(s, 1e5, h, n_quad=16, window_tol=1e-3)
+    for q in ("pressure", "stiffness", "area_fraction"):
+        assert np.allclose(getattr(b, q), getattr(a, q), rtol=1e-5, atol=0), q
+    mat = AsperityMaterial(E_star=1e5, nu=0.3, psi=1.0)
+    ep0, el0 = pop.elasto_plastic_and_elastic(s, mat, h, n_quad=8, n_t=8)
+    ep1, el1 = pop.elasto_plastic_and_elastic(s, mat, h, n_quad=8, n_t=8,
+                                                     window_tol=1e-3)
+    for r0, r1 in ((ep0, ep1), (el0, el1)):
+        for q in ("pressure", "stiffness", "area_fraction"):
+            assert np.all(np.isfinite(getattr(r1, q))), q
+            assert np.allclose(getattr(r1, q), getattr(r0, q), rtol=1e-4, atol=0), q
