@@ -146,7 +146,7 @@ def write_checkpoint(directory: str, problem, state: CheckpointState, sig: dict,
     if keyed:    # owned nodes by key (u_previous is the owned part already), points by position
         data.update(keys=problem.owned_node_keys(), x=problem.owned_dof_coordinates().copy(),
                     u_owned=problem.owned_solution_values().copy(),
-                    points=None if ci is None else ci.point_coordinates().copy())
+                    points=None if ci is None else _point_keys(ci))
     with open(os.path.join(path, f"rank{comm.rank}.pkl"), "wb") as f:
         pickle.dump(data, f, protocol=pickle.HIGHEST_PROTOCOL)
         f.flush()
@@ -312,7 +312,7 @@ def _restore_by_keys(directory: str, problem, files: list) -> Optional[np.ndarra
     bs = next((d["u_owned"].size // len(d["keys"]) for d in files if len(d["keys"])), 1)
     if ci is not None:
         points = np.concatenate([d["points"] for d in files])
-        j, ok_points = _match_points(points, ci.point_coordinates())
+        j, ok_points = _match_points(points, _point_keys(ci))
         same = same and ok_points
     if not comm.allreduce(bool(same), op=MPI.LAND):
         raise CheckpointError(
@@ -343,18 +343,46 @@ def _restore_by_keys(directory: str, problem, files: list) -> Optional[np.ndarra
     return u_previous
 
 
-def _match_points(saved: np.ndarray, mine: np.ndarray):
-    """For each of ``mine`` (m, 3), the index of the saved point at its position (within 1e-9
-    of the extent); (indices, all matched one to one)."""
-    from scipy.spatial import cKDTree
+def _point_keys(ci) -> np.ndarray:
+    """(n, 6) partition-independent keys of this rank's interface points: the point's position
+    and its facet's centroid (the points of a facet in order). The position alone is not a
+    key: the vertex rule puts a point of every facet at each shared vertex."""
+    x = np.asarray(ci.point_coordinates(), dtype=float)
+    n_qp = max(int(ci.n_qp), 1)
+    centroid = np.repeat(x.reshape(-1, n_qp, 3).mean(axis=1), n_qp, axis=0)
+    return np.hstack([x, centroid])
 
+
+def _match_points(saved: np.ndarray, mine: np.ndarray):
+    """For each of ``mine`` (m, 6) (:func:`_point_keys`), the index of the saved point with
+    the same key (within 1e-9 of the extent); (indices, all matched one to one). Points with
+    equal keys (a slot-filling copy of a point of the same facet, weight 0, same history)
+    are matched in the order they come."""
     if len(mine) == 0:
         return np.zeros(0, dtype=np.int64), True
     if len(saved) == 0:
         return np.zeros(len(mine), dtype=np.int64), False
-    extent = max(1.0, float(np.ptp(saved, axis=0).max()))
-    dist, j = cKDTree(saved).query(mine, k=1)
-    ok = bool(np.all(dist <= 1e-9 * extent)) and len(np.unique(j)) == len(j)
+    tol = 1e-9 * max(1.0, float(np.ptp(saved[:, :3], axis=0).max()))
+
+    def rows(keys):
+        q = np.floor(np.asarray(keys) / tol + 0.5).astype(np.int64)
+        order = np.lexsort(q.T[::-1])
+        qs = q[order]
+        new = np.ones(len(qs), dtype=bool)
+        new[1:] = np.any(qs[1:] != qs[:-1], axis=1)
+        start = np.maximum.accumulate(np.where(new, np.arange(len(qs)), 0))
+        occurrence = np.empty(len(qs), dtype=np.int64)
+        occurrence[order] = np.arange(len(qs)) - start     # rank among equal keys
+        return np.hstack([q, occurrence[:, None]])
+
+    a, b = rows(saved), rows(mine)
+    view = np.dtype((np.void, a.dtype.itemsize * a.shape[1]))
+    av = np.ascontiguousarray(a).view(view).ravel()
+    bv = np.ascontiguousarray(b).view(view).ravel()
+    order = np.argsort(av, kind="stable")
+    pos = np.minimum(np.searchsorted(av[order], bv), len(av) - 1)
+    j = order[pos]
+    ok = bool(np.all(av[j] == bv)) and len(np.unique(j)) == len(j)
     return np.asarray(j, dtype=np.int64), ok
 
 

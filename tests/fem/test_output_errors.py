@@ -35,7 +35,7 @@ def _increment(step):
     zero = dict(target=1.0, iterations=1, residual=0.0, n_points=0, n_active=0, n_slipping=0,
                 real_area=0.0, dissipation=0.0, cutbacks=0, wall_time=0.0, n_beyond_validity=0,
                 newton_total=1, linear_iterations=1, linear_total=1, failed_attempts=0,
-                augmentations=0)
+                augmentations=0, normal_dissipation=0.0, normal_dissipation_step=0.0)
     return SimpleNamespace(step=step, load_factor=0.5 * step, applied_force=np.zeros(3),
                            contact_force=np.zeros(3), **zero)
 
