@@ -33,7 +33,7 @@ __all__ = ["DOLFINX_VERSION", "NEW_API", "vector_space", "petsc_vector", "functi
            "node_input_indices", "geometry_input_indices",
            "create_petsc_vector", "form_sparsity", "block_csr_matrix", "near_nullspace",
            "mesh_domain", "create_mesh", "meshtags_from_arrays", "facet_geometry_nodes",
-           "set_bc", "apply_lifting", "write_meshtags", "DirichletBC"]
+           "set_bc", "set_bc_array", "apply_lifting", "write_meshtags", "DirichletBC"]
 
 DOLFINX_VERSION: tuple = tuple(int(p) for p in dolfinx.__version__.split(".")[:2])
 #: True on DOLFINx >= 0.8 (the API of 0.9); False on 0.5.2.
@@ -309,6 +309,16 @@ def set_bc(b, bcs: Sequence, x0=None, scale: float = 1.0) -> None:
         dolfinx.fem.petsc.set_bc(b, bcs, x0, alpha=scale)
     else:
         dolfinx.fem.petsc.set_bc(b, bcs, x0, scale=scale)
+
+
+def set_bc_array(x: np.ndarray, bcs: Sequence) -> None:
+    """Dirichlet values into the array x (owned and ghost entries); 0.9 deprecates
+    ``fem.set_bc`` for ``DirichletBC.set``."""
+    if NEW_API:
+        for bc in bcs:
+            bc.set(x)
+    else:
+        dolfinx.fem.set_bc(x, bcs)
 
 
 def apply_lifting(b, a: Sequence, bcs: Sequence, scale: float = 1.0) -> None:

@@ -279,7 +279,7 @@ class ContactProblem:
         self._matrices()
         self._seating(seating_tag, seating_stiffness)
         # Initial iterate satisfies the Dirichlet values.
-        fem.set_bc(self.u.x.array, self.bcs)
+        compat.set_bc_array(self.u.x.array, self.bcs)
         self.u.x.scatter_forward()
         self.b = self.f.duplicate()
         self.counters = {"residual": 0, "jacobian": 0}

@@ -233,12 +233,17 @@ _XI = "http://www.w3.org/2001/XInclude"
 
 
 def parse_xdmf(path: str):
-    """The root element of an XDMF file. DOLFINx 0.9 writes ``<xi:include>`` elements without
-    declaring the ``xi`` prefix (0.5.2 declares it); the declaration is added before parsing."""
+    """The root element of an XDMF file. DOLFINx 0.5.2 declares the ``xi`` prefix of its
+    ``<xi:include>`` elements as http://www.w3.org/2001/XInclude, 0.9 as https://...; an
+    undeclared prefix gets the former. The prefix is registered for the URI the file uses, so
+    that a file written back (e.g. cut to a restart's step) keeps ``xi:`` — the prefix the
+    writer uses for the steps it appends later."""
+    import re
     import xml.etree.ElementTree as ET
-    ET.register_namespace("xi", _XI)
     with open(path, encoding="utf-8") as f:
         xml = f.read()
-    if "xi:" in xml and "xmlns:xi" not in xml:
+    declared = re.search(r'xmlns:xi="([^"]+)"', xml)
+    if declared is None and "xi:" in xml:
         xml = xml.replace("<Xdmf ", f'<Xdmf xmlns:xi="{_XI}" ', 1)
+    ET.register_namespace("xi", declared.group(1) if declared else _XI)
     return ET.fromstring(xml)

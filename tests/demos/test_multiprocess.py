@@ -99,16 +99,15 @@ def _displacement_by_point(path: Path, time: float) -> dict:
     """{rounded node coordinates: (sum of the values, sum of their squares)} of the step at
     ``time`` of a DOLFINx displacement.xdmf, read through the mesh grid the step points to (a
     partition-free view: coincident nodes of two bodies are summed)."""
-    import xml.etree.ElementTree as ET
-
     import h5py
 
-    xi = "{http://www.w3.org/2001/XInclude}include"
-    root = ET.parse(path).getroot()
+    from rough_contact.io.files import parse_xdmf
+
+    root = parse_xdmf(str(path))     # the xi namespace: http (0.5.2) or https (0.9)
     domain = root.find("Domain")
     step = next(g for g in root.iter("Grid") if g.find("Time") is not None
                 and float(g.find("Time").get("Value")) == time)
-    pointer = step.find(xi).get("xpointer")
+    pointer = next(c for c in step if c.tag.endswith("}include")).get("xpointer")
     name = pointer.split("@Name='")[1].split("'")[0] if "@Name=" in pointer else None
     mesh = next(g for g in domain.findall("Grid") if g.get("GridType") == "Uniform"
                 and (name is None or g.get("Name") == name))

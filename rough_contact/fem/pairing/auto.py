@@ -43,6 +43,13 @@ class AutoPairing:
         self.search_radius = search_radius
         self.chosen: Optional[Pairing] = None
 
+    def describe(self) -> dict:
+        """Its options (``rough_contact.fingerprint.Describable``): what a checkpoint records
+        (the pairing it chose is recorded beside, by the interface)."""
+        return dict(second_tag=int(self.second_tag), nonmatching=self.nonmatching,
+                    match_tolerance=float(self.conforming.match_tolerance),
+                    search_radius=self.search_radius)
+
     def pair(self, ctx: SurfaceContext) -> PairedPoints:
         """The conforming points, or the non-matching pairing's (collective).
 
