@@ -74,7 +74,8 @@ def run(level: int, mu: float, k: float, width: float, predictor: str, quadratur
                k=k, predictor=predictor, quadrature=quadrature,
                reversal_stiffness=reversal_stiffness, augmented=augmented, al_tol=al_tol,
                continuation=("none" if cont is None else
-                             ",".join(f"{f:g}" for f in cont.factors) + f"/{cont.after}"),
+                             ",".join(f"{f:g}" for f in cont.factors)
+                             + ("" if cont.after is None else f"/{cont.after}")),
                linear_solver=m.solver.option_set,
                al_updates=sum(i.augmentations for i in incs),
                newton=sum(i.newton_total for i in incs),
@@ -107,8 +108,9 @@ def main(argv=None):
     ap.add_argument("--continuation", nargs="+", default=["none"],
                     help="penalty continuation: 'none' or softening factors, e.g. 100,10 "
                          "(rough_contact.solver.snes.Continuation)")
-    ap.add_argument("--after", type=int, default=Continuation().after,
-                    help="Newton iterations with the law itself before the continuation")
+    ap.add_argument("--after", default="none",
+                    help="Newton iterations with the law itself before the continuation "
+                         "(none: after a failed solve, the default of Continuation)")
     ap.add_argument("--linear-solver", nargs="+", default=["auto"],
                     help="SNESSolver linear_solver: auto (MUMPS up to the DOF threshold), "
                          "mumps, hypre, ...")
@@ -130,7 +132,8 @@ def main(argv=None):
                         for e in args.continuation for f in args.linear_solver]:
                     w = args.width if args.width is not None else 1e-2 * 2.5 / k
                     cont = (None if co == "none" else Continuation(
-                        tuple(float(x) for x in co.split(",")), args.after))
+                        tuple(float(x) for x in co.split(",")),
+                        None if args.after == "none" else int(args.after)))
                     r = run(level, mu, k, w, pred, quad, verbose=args.verbose,
                             reversal_stiffness=rs, augmented=bool(al), al_tol=args.al_tol,
                             continuation=cont, linear_solver=ls)

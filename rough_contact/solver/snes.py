@@ -120,21 +120,25 @@ class Continuation:
     factor, its Newton solve converges from the same start, and its solution is a start for the
     next, stiffer one from which Newton converges.
 
-    A solve first runs ``after`` Newton iterations with the law itself; if it has not converged
-    (or the law raised a ``ConvergenceError``), it starts again from the same initial iterate
-    with the law softened by ``factors[0]``, then ``factors[1]``, ..., each solve starting from
-    the previous one's solution, and ends with the law itself. Solves that converge within
-    ``after`` iterations are untouched (the same iterates as without continuation). The
-    converged answer is the law's own; only the path of the Newton iterates changes.
+    A solve first runs Newton with the law itself (at most ``after`` iterations; None: the
+    solver's ``snes_max_it``); if it has not converged (or the law raised a
+    ``ConvergenceError``), it starts again from the same initial iterate with the law softened
+    by ``factors[0]``, then ``factors[1]``, ..., each solve starting from the previous one's
+    solution, and ends with the law itself; if that fails too, the load stepping cuts back as
+    before. Solves that converge within ``after`` iterations are untouched (the same iterates
+    as without continuation): with ``after=None`` (the default) every solve that converges
+    without the continuation is unchanged, and only the solves that would fail (and cut back)
+    are retried. The converged answer is the law's own; only the path of the Newton iterates
+    changes.
 
     Args:
         factors: softening factors (each > 1, strictly decreasing) [-].
         after: Newton iterations (>= 0) with the law itself before the continuation; 0 runs the
-            continuation at every solve.
+            continuation at every solve; None: after a failed solve (``snes_max_it``).
     """
 
     factors: tuple = (100.0, 10.0)
-    after: int = 10
+    after: Optional[int] = None
 
     def __post_init__(self) -> None:
         f = tuple(float(check_scalar(f"continuation factor {i}", x, lo=1.0))
@@ -143,8 +147,8 @@ class Continuation:
             raise ValueError(f"continuation factors = {self.factors!r} are invalid: give at "
                              "least one factor > 1, strictly decreasing (e.g. (100, 10))")
         object.__setattr__(self, "factors", f)
-        if (not isinstance(self.after, (int, np.integer)) or isinstance(self.after, bool)
-                or self.after < 0):
+        if self.after is not None and (not isinstance(self.after, (int, np.integer))
+                                       or isinstance(self.after, bool) or self.after < 0):
             raise ValueError(f"continuation after = {self.after!r} is invalid: it must be an "
                              "integer >= 0 (Newton iterations with the law itself)")
 
@@ -387,10 +391,11 @@ class SNESSolver:
         if cont is None or interface is None or not interface.softenable:
             return self._solve(atol)
         stages, parts = [], []
-        if cont.after > 0:
+        if cont.after is None or cont.after > 0:
             u0 = self.problem.solution_vector().copy()
             max_it = self.snes.getTolerances()[3]
-            self.snes.setTolerances(max_it=min(cont.after, max_it))
+            self.snes.setTolerances(max_it=max_it if cont.after is None
+                                    else min(cont.after, max_it))
             try:
                 first = self._solve(atol)
             except ConvergenceError:
