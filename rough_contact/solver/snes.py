@@ -20,10 +20,10 @@ are removed again, so two solvers never see each other's settings
   single options of the set are overridden by the command line one by one. The measurements
   behind these choices are in ``docs/solver.md``.
 
-Penalty continuation (:class:`Continuation`, ``-rc_continuation 100,10``): a Newton solve of a
-stiff penalty law (``SoftenableLaw``) that has not converged after ``after`` iterations starts
-again from the same point with the penalty divided by the first factor, then the next, and
-finally solves the law itself from the last solution (docs/coulomb.md, "Penalty continuation").
+Penalty continuation (:class:`Continuation`, on by default; ``-rc_continuation none`` turns it
+off): a Newton solve of a penalty law that can be softened (``SoftenableLaw``) that has failed
+starts again from the same point with the penalty divided by 100, then by 10, and finally
+solves the law itself from the last solution (docs/coulomb.md, "Penalty continuation").
 
 Options given but never used (a mistyped ``-rc_snes_monitr``) are reported as a warning by
 :meth:`SNESSolver.report_unused_options`, which :meth:`SNESSolver.destroy` calls.
@@ -259,8 +259,11 @@ class SNESSolver:
         defaults: extra default options (without prefix) that override the option set but
             not the command line.
         continuation: :class:`Continuation` for penalty laws that can be softened
-            (``SoftenableLaw``), or None (default: none); ``-<prefix>continuation 100,10``
-            (or ``none``) and ``-<prefix>continuation_after N`` override it.
+            (``SoftenableLaw``; other laws ignore it), or None. The default,
+            ``Continuation()``, retries only the solves that failed, so every solve that
+            converges without it is unchanged (docs/coulomb.md, "Penalty continuation");
+            ``-<prefix>continuation 100,10`` (or ``none``) and
+            ``-<prefix>continuation_after N`` override it.
     """
 
     def __init__(
@@ -271,7 +274,7 @@ class SNESSolver:
         linear_solver: str = "auto",
         near_nullspace: Union[str, PETSc.NullSpace] = "global",
         defaults: Optional[Mapping[str, object]] = None,
-        continuation: Optional[Continuation] = None,
+        continuation: Optional[Continuation] = Continuation(),
     ):
         if not isinstance(prefix, str) or (prefix and not prefix.endswith("_")):
             raise ValueError(f"options prefix {prefix!r} must be a string ending with '_'")
