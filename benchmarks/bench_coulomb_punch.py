@@ -106,8 +106,8 @@ def main(argv=None):
     ap.add_argument("--al-tol", type=float, default=1e-3,
                     help="AugmentedLagrangian.tolerance")
     ap.add_argument("--continuation", nargs="+", default=["100,10"],
-                    help="penalty continuation: softening factors (default 100,10, the solver's) or none "
-                         "(rough_contact.solver.snes.Continuation)")
+                    help="penalty continuation: softening factors (default 100,10, the "
+                         "solver's) or none (rough_contact.solver.snes.Continuation)")
     ap.add_argument("--after", default="none",
                     help="Newton iterations with the law itself before the continuation "
                          "(none: after a failed solve, the default of Continuation)")
