@@ -10,7 +10,8 @@ increment, CPU time and the dissipation at the peak and at the end.
 
     OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bench_coulomb_punch.py \\
         [--levels 1 2 3] [--mu 0.2 0.5] [--k 1e7] [--predictor none secant]
-        [--reversal-stiffness 0 1] [--augmented 0 1] [--al-tol 1e-3] [--csv FILE]
+        [--reversal-stiffness 0 1] [--augmented 0 1] [--al-tol 1e-3]
+        [--continuation none 100,10] [--after 10] [--linear-solver auto mumps hypre] [--csv FILE]
 
 Levels (P1; mesh and contact size in LEVELS): 1 ~4.5 k DOFs, 2 ~26 k, 3 ~73 k, 4 ~99 k (the size
 of GetFEM's finest run).
@@ -35,7 +36,8 @@ from petsc4py import PETSc  # noqa: E402
 from rough_contact.interface.enforcement import AugmentedLagrangian, Penalty
 from rough_contact.interface.penalty import SoftplusPenalty
 from rough_contact.scenes import flat_punch
-from rough_contact.solver.loading import load_path, load_unload_factors
+from rough_contact.solver.loading import LoadStepError, load_path, load_unload_factors
+from rough_contact.solver.snes import Continuation
 
 # (mesh size, contact size) [mm]
 LEVELS = {1: (10.0, 0.7), 2: (5.0, 0.3), 3: (3.3, 0.2), 4: (3.3, 0.165)}
@@ -44,32 +46,46 @@ N_LOAD = 16
 
 def run(level: int, mu: float, k: float, width: float, predictor: str, quadrature="gauss",
         comm=MPI.COMM_WORLD, verbose=False, reversal_stiffness=1.0, augmented=False,
-        al_tol=1e-3) -> dict:
+        al_tol=1e-3, continuation=None, linear_solver="auto") -> dict:
     mesh_size, contact_size = LEVELS[level]
     law = SoftplusPenalty(k_normal=k, width=width, k_tangential=k, friction=mu,
                           reversal_stiffness=reversal_stiffness)
     enforcement = AugmentedLagrangian(tolerance=al_tol) if augmented else Penalty()
     m = flat_punch.build(comm, mesh_size=mesh_size, contact_size=contact_size, order=1,
                          load_half_width=10.0, law=law, steps=N_LOAD, quadrature=quadrature,
-                         enforcement=enforcement)
+                         enforcement=enforcement,
+                         solver_options=dict(continuation=continuation,
+                                             linear_solver=linear_solver))
     factors = load_unload_factors(N_LOAD, N_LOAD - 1, final_factor=1.0 / N_LOAD)
     t0 = time.process_time()
     incs = []
     kwargs = {"predictor": predictor}
-    for inc in load_path(m.problem, m.solver, factors, verbose=verbose, **kwargs):
-        incs.append(inc)
+    failed = ""
+    try:
+        for inc in load_path(m.problem, m.solver, factors, verbose=verbose, **kwargs):
+            incs.append(inc)
+    except LoadStepError as exc:     # reported as a row: the run did not complete
+        failed = f"LoadStepError at load factor {exc.load_factor:.6g}"
+        PETSc.Sys.Print(f"  FAILED: {exc}")
     cpu = comm.allreduce(time.process_time() - t0, op=MPI.SUM)
-    peak = next(i for i in incs if i.load_factor == 1.0)
+    peak = next((i for i in incs if i.load_factor == 1.0), None)
+    cont = m.solver.continuation
     out = dict(level=level, dofs=m.problem.num_dofs, points=m.interface.n_points_global, mu=mu,
                k=k, predictor=predictor, quadrature=quadrature,
                reversal_stiffness=reversal_stiffness, augmented=augmented, al_tol=al_tol,
+               continuation=("none" if cont is None else
+                             ",".join(f"{f:g}" for f in cont.factors)
+                             + ("" if cont.after is None else f"/{cont.after}")),
+               linear_solver=m.solver.option_set,
                al_updates=sum(i.augmentations for i in incs),
                newton=sum(i.newton_total for i in incs),
                solves=len(incs) + sum(i.failed_attempts for i in incs),
                cutbacks=sum(i.cutbacks for i in incs),
-               max_its=max(i.iterations for i in incs), cpu=cpu,
-               D_peak=peak.dissipation, D_end=incs[-1].dissipation,
-               slip_peak=peak.n_slipping / max(peak.n_points, 1))
+               max_its=max((i.iterations for i in incs), default=0), cpu=cpu,
+               D_peak=peak.dissipation if peak else float("nan"),
+               D_end=float("nan") if failed else incs[-1].dissipation,
+               slip_peak=peak.n_slipping / max(peak.n_points, 1) if peak else float("nan"),
+               failed=failed)
     m.solver.destroy()
     return out
 
@@ -89,33 +105,48 @@ def main(argv=None):
                     help="1 = augmented Lagrangian (Uzawa) on top of the penalty")
     ap.add_argument("--al-tol", type=float, default=1e-3,
                     help="AugmentedLagrangian.tolerance")
+    ap.add_argument("--continuation", nargs="+", default=["100,10"],
+                    help="penalty continuation: softening factors (default 100,10, the "
+                         "solver's) or none (rough_contact.solver.snes.Continuation)")
+    ap.add_argument("--after", default="none",
+                    help="Newton iterations with the law itself before the continuation "
+                         "(none: after a failed solve, the default of Continuation)")
+    ap.add_argument("--linear-solver", nargs="+", default=["auto"],
+                    help="SNESSolver linear_solver: auto (MUMPS up to the DOF threshold), "
+                         "mumps, hypre, ...")
     ap.add_argument("--csv", default=None)
     ap.add_argument("--verbose", action="store_true")
     args, _petsc = ap.parse_known_args(argv)   # the rest goes to PETSc
     rows = []
     head = (f"{'level':>5} {'DOFs':>7} {'points':>6} {'mu':>4} {'k':>7} {'rev':>4} "
-            f"{'predictor':>9} {'AL':>2} {'upd':>4} "
+            f"{'predictor':>9} {'AL':>2} {'upd':>4} {'cont':>10} {'linear':>6} "
             f"{'Newton':>6} {'solves':>6} {'cutb':>4} {'max/inc':>7} {'CPU s':>7} "
             f"{'D peak':>10} {'D end':>10} {'slip':>5}")
     PETSc.Sys.Print(head)
     for level in args.levels:
         for mu in args.mu:
             for k in args.k:
-                for pred, quad, rs, al in [(a, b, c, d) for a in args.predictor
-                                           for b in args.quadrature
-                                           for c in args.reversal_stiffness
-                                           for d in args.augmented]:
+                for pred, quad, rs, al, co, ls in [
+                        (a, b, c, d, e, f) for a in args.predictor for b in args.quadrature
+                        for c in args.reversal_stiffness for d in args.augmented
+                        for e in args.continuation for f in args.linear_solver]:
                     w = args.width if args.width is not None else 1e-2 * 2.5 / k
+                    cont = (None if co == "none" else Continuation(
+                        tuple(float(x) for x in co.split(",")),
+                        None if args.after == "none" else int(args.after)))
                     r = run(level, mu, k, w, pred, quad, verbose=args.verbose,
-                            reversal_stiffness=rs, augmented=bool(al), al_tol=args.al_tol)
+                            reversal_stiffness=rs, augmented=bool(al), al_tol=args.al_tol,
+                            continuation=cont, linear_solver=ls)
                     rows.append(r)
                     PETSc.Sys.Print(
                         f"{r['level']:5d} {r['dofs']:7d} {r['points']:6d} {mu:4.2f} {k:7.1e} "
                         f"{rs:4.2g} {pred + '/' + quad[0]:>9} {al:2d} {r['al_updates']:4d} "
+                        f"{r['continuation']:>10} {r['linear_solver']:>6} "
                         f"{r['newton']:6d} "
                         f"{r['solves']:6d} {r['cutbacks']:4d} "
                         f"{r['max_its']:7d} {r['cpu']:7.1f} {r['D_peak']:10.4e} "
-                        f"{r['D_end']:10.4e} {r['slip_peak']:5.2f}")
+                        f"{r['D_end']:10.4e} {r['slip_peak']:5.2f}"
+                        + (f"  FAILED ({r['failed']})" if r["failed"] else ""))
     if args.csv and MPI.COMM_WORLD.rank == 0:
         write_csv(args.csv, rows)
     return rows

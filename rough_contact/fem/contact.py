@@ -62,9 +62,10 @@ from rough_contact.fem.pairing.facets import (FacetGeometry, FacetRule, facet_co
 from rough_contact.fem.queries import InterfaceQueries, InterfaceSummary, PointFields
 from rough_contact.fem.rigid import RigidSurface
 from rough_contact.interface.contract import (ConvergenceError, InterfaceLawProtocol, LawResult,
-                                              NewtonTangentLaw)
+                                              NewtonTangentLaw, SoftenableLaw)
 from rough_contact.interface.enforcement import AugmentedLagrangian, Enforcement, Penalty
 from rough_contact.interface.state import InterfaceHistory
+from rough_contact.validation import check_scalar
 
 __all__ = ["ContactInterface", "InterfaceSummary", "PointFields", "Acceptance"]
 
@@ -177,6 +178,7 @@ class ContactInterface(InterfaceQueries):
                                         self.enforcement.initial_multipliers(n))
         self._last = self._last_jump = self._newton_memo = None
         self._result_checked = False  # the first evaluation's result is checked in full
+        self._softened = None         # (factor, law.softened(factor)) during a continuation
 
     def _set_operator(self, operator: JumpOperator, jump0: Optional[np.ndarray] = None):
         self.operator = operator
@@ -243,7 +245,39 @@ class ContactInterface(InterfaceQueries):
         return res
 
     def _evaluating_law(self) -> InterfaceLawProtocol:
-        return self.enforcement.law_for(self.law, self.history.multipliers)
+        law = self.law if self._softened is None else self._softened[1]
+        return self.enforcement.law_for(law, self.history.multipliers)
+
+    @property
+    def softenable(self) -> bool:
+        """Whether the law can be softened (``SoftenableLaw``: Newton's penalty continuation)."""
+        return isinstance(self.law, SoftenableLaw)
+
+    @property
+    def softening(self) -> float:
+        """The factor the law's penalty is divided by in the evaluations (1: the law itself)."""
+        return 1.0 if self._softened is None else self._softened[0]
+
+    def set_softening(self, factor: float) -> None:
+        """Evaluate ``law.softened(factor)`` instead of the law until set back to 1 (no
+        communication; the committed history is shared, the trial state is the last
+        evaluation's). ``SNESSolver`` does this for a penalty continuation.
+
+        Raises:
+            TypeError: factor > 1 for a law that is not a ``SoftenableLaw``.
+            ValueError: factor < 1 or not finite.
+        """
+        factor = check_scalar("softening factor", factor, lo=1.0, lo_open=False)
+        if factor == 1.0:
+            self._softened = None
+        else:
+            if not self.softenable:
+                raise TypeError(f"the law {type(self.law).__name__} cannot be softened for a "
+                                "penalty continuation (it is no rough_contact.interface."
+                                "contract.SoftenableLaw: softened(factor))")
+            if self._softened is None or self._softened[0] != factor:
+                self._softened = (factor, self.law.softened(factor))
+        self._forget()
 
     def _check_finite(self, what: str, jump: np.ndarray, finite: np.ndarray) -> None:
         if finite.all():

@@ -71,8 +71,8 @@ from typing import Optional, Protocol, TypeVar, runtime_checkable
 import numpy as np
 
 __all__ = ["ConvergenceError", "LawState", "LawResult", "InterfaceLawProtocol",
-           "FrictionBoundedLaw", "NewtonTangentLaw", "MultiplierLaw", "LawContractError",
-           "check_jump"]
+           "FrictionBoundedLaw", "NewtonTangentLaw", "MultiplierLaw", "SoftenableLaw",
+           "LawContractError", "check_jump"]
 
 
 class ConvergenceError(ArithmeticError):
@@ -244,6 +244,23 @@ class MultiplierLaw(Protocol):
         """The law with its penalty shifted by ``multipliers`` (n, 3) [MPa]: an object with the
         same ``initial_state``/``evaluate`` (and ``newton_tangent``, if the law has one) for
         those n points; cheap to create (no copy of the arrays)."""
+        ...
+
+
+@runtime_checkable
+class SoftenableLaw(Protocol):
+    """A penalty law that can give the same law at a softer penalty, for Newton's penalty
+    continuation (``rough_contact.solver.snes.Continuation``): a stiff penalty's stick/slip and
+    contact switches happen within a jump of order traction / penalty, far below a Newton step,
+    and a Newton solve from a far start stalls; the solver first solves with the softened law
+    and starts the law itself from that solution. The softened law takes and returns the same
+    states as the law (the committed history is shared); the converged answer is the law's
+    own, the softened law only supplies a starting point."""
+
+    def softened(self, factor: float) -> InterfaceLawProtocol:
+        """The law with its penalty stiffnesses divided by ``factor`` (>= 1) [-] (and any
+        smoothing length of the penalty multiplied by it, so the pressure at zero gap is
+        kept)."""
         ...
 
 

@@ -11,7 +11,7 @@ Units: mm, N, MPa. Jumps [mm]; tractions [MPa]; stiffnesses per area [MPa/mm].
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Optional
 
 import numpy as np
@@ -153,6 +153,15 @@ class SoftplusPenalty:
         """The law with its penalty shifted by ``multipliers`` (n, 3) [MPa]
         (``rough_contact.interface.contract.MultiplierLaw``)."""
         return ShiftedSoftplusPenalty(self, multipliers)
+
+    def softened(self, factor: float) -> SoftplusPenalty:
+        """The law with k_N and k_T divided by ``factor`` >= 1 and the width multiplied by it
+        (p(0) = k_N w ln 2 kept; friction and ``reversal_stiffness`` unchanged): the starting
+        law of Newton's penalty continuation
+        (``rough_contact.interface.contract.SoftenableLaw``)."""
+        f = check_scalar("softening factor", factor, lo=1.0, lo_open=False)
+        return replace(self, k_normal=self.k_normal / f, width=self.width * f,
+                       k_tangential=self.k_tangential / f)
 
     def _shifts(self, multipliers: Optional[np.ndarray]):
         """(gap shift lambda_N / k_N (n,) [mm], tangential multiplier (n, 2) [MPa]); the scalar

@@ -20,6 +20,11 @@ are removed again, so two solvers never see each other's settings
   single options of the set are overridden by the command line one by one. The measurements
   behind these choices are in ``docs/solver.md``.
 
+Penalty continuation (:class:`Continuation`, on by default; ``-rc_continuation none`` turns it
+off): a Newton solve of a penalty law that can be softened (``SoftenableLaw``) that has failed
+starts again from the same point with the penalty divided by 100, then by 10, and finally
+solves the law itself from the last solution (docs/coulomb.md, "Penalty continuation").
+
 Options given but never used (a mistyped ``-rc_snes_monitr``) are reported as a warning by
 :meth:`SNESSolver.report_unused_options`, which :meth:`SNESSolver.destroy` calls.
 
@@ -40,11 +45,12 @@ import numpy as np
 from petsc4py import PETSc
 
 from rough_contact.fem.problem import ContactProblem, rigid_body_modes
+from rough_contact.interface.contract import ConvergenceError
 from rough_contact.solver.options import default_options, set_default_options, unused_options
 from rough_contact.validation import check_scalar
 
 __all__ = ["SolveResult", "SNESSolver", "UnusedOptionsWarning", "set_default_options",
-           "LINEAR_SOLVERS", "AMG_DEFAULT", "DEFAULT_DOF_THRESHOLD"]
+           "LINEAR_SOLVERS", "AMG_DEFAULT", "DEFAULT_DOF_THRESHOLD", "Continuation"]
 
 
 # The option sets (PETSc option names without prefix) and the size rule; the figures behind
@@ -103,6 +109,62 @@ AMG_DEFAULT = "hypre"
 DEFAULT_DOF_THRESHOLD = 30_000
 
 
+@dataclass(frozen=True)
+class Continuation:
+    """Newton's penalty continuation for stiff penalty laws.
+
+    A stiff penalty k switches a point between stick and slip (or contact and separation)
+    within a jump of order traction / k; at k = 1e9 MPa/mm on the Coulomb punch that is 1e-9 mm,
+    a tenth of a Newton step, and the line search crawls (docs/coulomb.md). The softened law
+    (``SoftenableLaw.softened``: k / factor) has its switches spread over a range wider by the
+    factor, its Newton solve converges from the same start, and its solution is a start for the
+    next, stiffer one from which Newton converges.
+
+    A solve first runs Newton with the law itself (at most ``after`` iterations; None: the
+    solver's ``snes_max_it``); if it has not converged (or the law raised a
+    ``ConvergenceError``), it starts again from the same initial iterate with the law softened
+    by ``factors[0]``, then ``factors[1]``, ..., each solve starting from the previous one's
+    solution, and ends with the law itself; if that fails too, the load stepping cuts back as
+    before. Solves that converge within ``after`` iterations are untouched (the same iterates
+    as without continuation): with ``after=None`` (the default) every solve that converges
+    without the continuation is unchanged, and only the solves that would fail (and cut back)
+    are retried. The converged answer is the law's own; only the path of the Newton iterates
+    changes.
+
+    Args:
+        factors: softening factors (each > 1, strictly decreasing) [-].
+        after: Newton iterations (>= 0) with the law itself before the continuation; 0 runs the
+            continuation at every solve; None: after a failed solve (``snes_max_it``).
+    """
+
+    factors: tuple = (100.0, 10.0)
+    after: Optional[int] = None
+
+    def __post_init__(self) -> None:
+        f = tuple(float(check_scalar(f"continuation factor {i}", x, lo=1.0))
+                  for i, x in enumerate(self.factors))
+        if not f or any(b >= a for a, b in zip(f, f[1:])):
+            raise ValueError(f"continuation factors = {self.factors!r} are invalid: give at "
+                             "least one factor > 1, strictly decreasing (e.g. (100, 10))")
+        object.__setattr__(self, "factors", f)
+        if self.after is not None and (not isinstance(self.after, (int, np.integer))
+                                       or isinstance(self.after, bool) or self.after < 0):
+            raise ValueError(f"continuation after = {self.after!r} is invalid: it must be an "
+                             "integer >= 0 (Newton iterations with the law itself)")
+
+
+def _parse_continuation(text: str) -> Optional[Continuation]:
+    """``-PREFIXcontinuation``: "none" or comma-separated factors ("100,10")."""
+    if text.strip().lower() in ("none", "off", "false", "0", ""):
+        return None
+    try:
+        factors = tuple(float(t) for t in text.split(","))
+    except ValueError:
+        raise ValueError(f"continuation = {text!r} is invalid: give 'none' or comma-separated "
+                         "softening factors > 1, decreasing (e.g. 100,10)") from None
+    return Continuation(factors)
+
+
 class UnusedOptionsWarning(UserWarning):
     """PETSc options were given under a solver's prefix but never read (mistyped?)."""
 
@@ -115,9 +177,12 @@ class SolveResult:
         converged: SNES reported convergence.
         reason: SNES converged reason (int; negative = diverged).
         reason_name: readable name of ``reason``.
-        iterations: Newton iterations.
-        residuals: residual 2-norms, one per iteration (iteration 0 first) [N].
+        iterations: Newton iterations (all solves of a continuation).
+        residuals: residual 2-norms, one per iteration (iteration 0 first) [N]; with a
+            continuation those of every solve, one after the other.
         linear_iterations: total KSP iterations.
+        stages: with a continuation, (softening factor, Newton iterations, converged) of each
+            solve in order (factor 1: the law itself); empty without.
     """
 
     converged: bool
@@ -126,6 +191,7 @@ class SolveResult:
     iterations: int
     residuals: list = field(default_factory=list)
     linear_iterations: int = 0
+    stages: list = field(default_factory=list)
 
 
 def _reason_name(reason: int) -> str:
@@ -192,6 +258,12 @@ class SNESSolver:
             overrides a name.
         defaults: extra default options (without prefix) that override the option set but
             not the command line.
+        continuation: :class:`Continuation` for penalty laws that can be softened
+            (``SoftenableLaw``; other laws ignore it), or None. The default,
+            ``Continuation()``, retries only the solves that failed, so every solve that
+            converges without it is unchanged (docs/coulomb.md, "Penalty continuation");
+            ``-<prefix>continuation 100,10`` (or ``none``) and
+            ``-<prefix>continuation_after N`` override it.
     """
 
     def __init__(
@@ -202,6 +274,7 @@ class SNESSolver:
         linear_solver: str = "auto",
         near_nullspace: Union[str, PETSc.NullSpace] = "global",
         defaults: Optional[Mapping[str, object]] = None,
+        continuation: Optional[Continuation] = Continuation(),
     ):
         if not isinstance(prefix, str) or (prefix and not prefix.endswith("_")):
             raise ValueError(f"options prefix {prefix!r} must be a string ending with '_'")
@@ -212,6 +285,16 @@ class SNESSolver:
         self.dof_threshold, linear_solver = _choose_linear_solver(
             cmd, prefix, problem.num_dofs, dof_threshold, linear_solver)
         self.option_set = linear_solver
+        if cmd.hasName(prefix + "continuation"):
+            continuation = _parse_continuation(cmd.getString(prefix + "continuation"))
+        if continuation is not None and not isinstance(continuation, Continuation):
+            raise TypeError(f"continuation must be a Continuation or None, got "
+                            f"{type(continuation).__name__}")
+        if cmd.hasName(prefix + "continuation_after"):
+            after = cmd.getInt(prefix + "continuation_after")
+            continuation = Continuation(continuation.factors if continuation else
+                                        Continuation().factors, after)
+        self.continuation = continuation
         if cmd.hasName(prefix + "near_nullspace"):
             near_nullspace = cmd.getString(prefix + "near_nullspace")
         if isinstance(near_nullspace, str) and near_nullspace not in ("global", "per_body"):
@@ -289,6 +372,10 @@ class SNESSolver:
     def solve(self, atol: Optional[float] = None) -> SolveResult:
         """Solve F(u) = 0 starting from ``problem.u``; on success ``problem.u`` holds the root.
 
+        With a :class:`Continuation` and a law that can be softened, a solve that has not
+        converged after ``continuation.after`` iterations is done again from the same start
+        through the softened laws (see :class:`Continuation`); the result sums the solves.
+
         On failure ``problem.u`` holds the last iterate: the caller reverts it.
 
         Args:
@@ -302,6 +389,53 @@ class SNESSolver:
                 of the interface), and ``PETSc.Error`` (not a convergence failure: numerical
                 failures of the linear solver come back as a negative converged reason).
         """
+        interface = self.problem.interface
+        cont = self.continuation
+        if cont is None or interface is None or not interface.softenable:
+            return self._solve(atol)
+        stages, parts = [], []
+        if cont.after is None or cont.after > 0:
+            u0 = self.problem.solution_vector().copy()
+            max_it = self.snes.getTolerances()[3]
+            self.snes.setTolerances(max_it=max_it if cont.after is None
+                                    else min(cont.after, max_it))
+            try:
+                first = self._solve(atol)
+            except ConvergenceError:
+                first = SolveResult(False, 0, "CONVERGENCE_ERROR",
+                                    self.snes.getIterationNumber(), [],
+                                    self.snes.getLinearSolveIterations())
+            finally:
+                self.snes.setTolerances(max_it=max_it)
+            if first.converged:
+                return first
+            stages.append((1.0, first.iterations, False))
+            parts.append(first)
+            u0.copy(self.problem.solution_vector())    # start again from the same point
+            self.problem.scatter_solution()
+            u0.destroy()
+        try:
+            for factor in cont.factors:
+                interface.set_softening(factor)
+                r = self._solve(atol)
+                stages.append((factor, r.iterations, r.converged))
+                parts.append(r)
+                if not r.converged:
+                    break
+        finally:
+            interface.set_softening(1.0)
+        if parts[-1].converged:
+            r = self._solve(atol)
+            stages.append((1.0, r.iterations, r.converged))
+            parts.append(r)
+        last = parts[-1]
+        return SolveResult(last.converged, last.reason, last.reason_name,
+                           sum(p.iterations for p in parts),
+                           [x for p in parts for x in p.residuals],
+                           sum(p.linear_iterations for p in parts), stages)
+
+    def _solve(self, atol: Optional[float]) -> SolveResult:
+        """One Newton solve of the current law (see :meth:`solve`)."""
         self._residuals = []
         if self.problem.A is not self._A:          # new pattern after a re-pairing
             self.snes.setJacobian(self.problem.J, self.problem.A)

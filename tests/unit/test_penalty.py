@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rough_contact.interface.contract import ConvergenceError, MultiplierLaw, NewtonTangentLaw
+from rough_contact.interface.contract import (ConvergenceError, MultiplierLaw, NewtonTangentLaw,
+                                              SoftenableLaw)
 from rough_contact.interface.enforcement import AugmentedLagrangian
 from rough_contact.interface.penalty import LinearPenalty, SoftplusPenalty
 from rough_contact.interface.state import InterfaceState
@@ -290,3 +291,24 @@ def test_softplus_counts_slip_only_in_contact():
     res = law.evaluate(many, InterfaceState.zeros(500))
     assert not np.any(res.slipping & ~res.contact)
     assert 0 < res.slipping.sum() < res.contact.sum() < 500
+
+
+def test_softened_law():
+    """SoftplusPenalty.softened(f): k_N, k_T / f, width x f; p(0) = k_N w ln 2 and the
+    friction unchanged; pressures deep in contact from the closed form k_N (-g) / f."""
+    law = SoftplusPenalty(k_normal=1e9, width=2.5e-11, k_tangential=5e8, friction=0.3)
+    soft = law.softened(100.0)
+    assert isinstance(soft, SoftenableLaw) and isinstance(law, SoftenableLaw)
+    assert (soft.k_normal, soft.k_tangential) == (1e7, 5e6)
+    assert soft.width == pytest.approx(2.5e-9, rel=1e-15)
+    assert (soft.friction, soft.reversal_stiffness) == (law.friction, law.reversal_stiffness)
+    p0, _ = law.normal(np.zeros(1))
+    p0s, _ = soft.normal(np.zeros(1))
+    assert p0s[0] == pytest.approx(1e9 * 2.5e-11 * np.log(2.0), rel=1e-12)
+    assert p0s[0] == pytest.approx(p0[0], rel=1e-12)
+    g = np.array([-1e-5])                    # 4000 widths deep: p = k (-g) to round-off
+    assert soft.normal(g)[0][0] == pytest.approx(1e7 * 1e-5, rel=1e-12)
+    assert law.softened(1.0) == law
+    for bad in (0.5, float("nan"), "10"):
+        with pytest.raises(ValueError, match="softening factor"):
+            law.softened(bad)
