@@ -138,7 +138,10 @@ def test_uncaught_exception_on_some_ranks_aborts(tmp_path):
                                  cwd=tmp_path, env=env, capture_output=True, text=True,
                                  timeout=120) for mode in ("one", "all")}
     one, every = runs["one"], runs["all"]
-    assert one.returncode != 0 and "MPI_ABORT" in one.stderr, one.stderr[-2000:]
+    # rank 0 of "one" waits in a barrier that only an abort ends: the run returning at all
+    # (within the timeout) shows the abort. Its banner's text is not checked: Open MPI's help
+    # system sometimes fails to print it ("Data unpack would read past end of buffer").
+    assert one.returncode != 0, one.stderr[-2000:]
     assert "ValueError: steps = 0 is invalid (rank 1 of 2)" in one.stderr
     assert every.returncode != 0 and "MPI_ABORT" not in every.stderr, every.stderr[-2000:]
     own = _own_stderr(every.stderr)
