@@ -50,71 +50,97 @@ from .normal import NormalLaw
 
 __all__ = ["HistoryNormalLawProtocol", "HistoryNormalLaw"]
 
-# bicubic Hermite: f(tm, tx) = [1 tm tm^2 tm^3] M F M^T [1 tx tx^2 tx^3]^T
-_M = np.array([[1.0, 0.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [-3.0, 3.0, -2.0, -1.0],
-               [2.0, -2.0, 1.0, 1.0]])
+# Uniform cubic B-spline blending in h_min: on row cell i, f(tm) = sum_a b_a(tm) c[i + a] with
+# b_a(tm) = sum_p _B[a, p] tm^p >= 0 and sum_a b_a = 1 (a convex combination of 4 control rows).
+_B = np.array([[1.0, -3.0, 3.0, -1.0], [4.0, 0.0, -6.0, 3.0], [1.0, 3.0, 3.0, -3.0],
+               [0.0, 0.0, 0.0, 1.0]]) / 6.0
+_BLOCK = 4096
 
 
-@runtime_checkable
-class HistoryNormalLawProtocol(Protocol):
-    """A normal law with one history variable per point, h_min (smallest separation so far).
-
-    ``rough_contact.interface.law.InterfaceLaw`` keeps h_min in its state when its normal law
-    implements this protocol (the irreversible knob); a plain ``NormalLawProtocol`` stays
-    reversible.
-    """
-
-    def evaluate_history(self, h: np.ndarray, h_min: np.ndarray, curvature: bool = False
-                         ) -> Tuple[np.ndarray, ...]:
-        """(p, k, a) or (p, k, a, dk/dh) at separations h (n,) [mm] after the smallest
-        separation h_min (n,) [mm]; where h <= h_min the loading branch (the caller commits
-        min(h, h_min)). k = -dp/dh at fixed h_min."""
-        ...
-
-    def normal_dissipation(self, h_min: np.ndarray) -> np.ndarray:
-        """D(h_min) (n,) [N/mm]: energy per nominal area dissipated by loading to h_min, so
-        that the work of any path is psi(h, h_min) + D(h_min); 0 where nothing yielded."""
-        ...
+def _spline_controls(V):
+    """Control rows (n+3, ...) of the uniform cubic B-spline through the row data V (n+1, ...)
+    at uniform rows, with the not-a-knot end conditions (third derivative continuous at the
+    second and the last-but-one row). n >= 3."""
+    n = V.shape[0] - 1
+    M = np.zeros((n + 3, n + 3))
+    for i in range(n + 1):
+        M[i, i:i + 3] = (1.0 / 6.0, 4.0 / 6.0, 1.0 / 6.0)
+    M[n + 1, 0:5] = (-1.0, 4.0, -6.0, 4.0, -1.0)
+    M[n + 2, n - 2:n + 3] = (-1.0, 4.0, -6.0, 4.0, -1.0)
+    rhs = np.zeros((n + 3,) + V.shape[1:])
+    rhs[:n + 1] = V
+    return np.linalg.solve(M, rhs.reshape(n + 3, -1)).reshape(rhs.shape)
 
 
-def _fd(v, d, axis):
-    """Derivative along ``axis`` on a uniform grid of step d: central, one-sided 3-point ends."""
-    v = np.moveaxis(v, axis, 0)
-    out = np.empty_like(v)
-    if v.shape[0] >= 3:
-        out[1:-1] = (v[2:] - v[:-2]) / (2 * d)
-        out[0] = (-3 * v[0] + 4 * v[1] - v[2]) / (2 * d)
-        out[-1] = (3 * v[-1] - 4 * v[-2] + v[-3]) / (2 * d)
-    else:
-        out[:] = (v[-1] - v[0]) / d
-    return np.moveaxis(out, 0, axis)
+def _monotone_controls(v, d, xk):
+    """Project Hermite data (values v, x-slopes d; (n_c, n_k)) of every control row into the
+    set of non-increasing cubic Hermite curves: values made non-increasing along x (running
+    minimum), slopes clipped to <= 0 (0 next to a flat secant) and scaled into the
+    Fritsch-Carlson circle alpha^2 + beta^2 <= 9. Returns (v, d, number of data changed)."""
+    v2 = np.minimum.accumulate(v, axis=1)
+    sec = np.diff(v2, axis=1) / np.diff(xk)
+    d2 = np.minimum(d, 0.0)
+    flat = sec >= 0.0
+    d2[:, :-1] = np.where(flat, 0.0, d2[:, :-1])
+    d2[:, 1:] = np.where(flat, 0.0, d2[:, 1:])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        al = np.where(flat, 0.0, d2[:, :-1] / sec)
+        be = np.where(flat, 0.0, d2[:, 1:] / sec)
+        r = np.hypot(al, be)
+        tau = np.where(r > 3.0, 3.0 / r, 1.0)
+    fac = np.ones_like(d2)
+    fac[:, :-1] = tau
+    fac[:, 1:] = np.minimum(fac[:, 1:], tau)
+    d2 = d2 * fac
+    changed = int(np.count_nonzero(v2 != v) + np.count_nonzero(d2 != d))
+    return v2, d2, changed
 
 
-def _bicubic(f, fx, dm, dx):
-    """Cell coefficients (n_m-1, n_x-1, 4, 4) from grid values f and exact x-slopes fx."""
-    fm = _fd(f, dm, 0)
-    fmx = _fd(fx, dm, 0)
-    n_m, n_x = f.shape[0] - 1, f.shape[1] - 1
-    F = np.empty((n_m, n_x, 4, 4))
-    for a, (ia, sa) in enumerate(((0, 0), (1, 0), (0, 1), (1, 1))):
-        # rows of F: f(i), f(i+1), dm f(i), dm f(i+1); columns the same in x
-        for b, (jb, sb) in enumerate(((0, 0), (1, 0), (0, 1), (1, 1))):
-            src = (f, fx, fm, fmx)[sb + 2 * sa]
-            scale = (dx if sb else 1.0) * (dm if sa else 1.0)
-            F[:, :, a, b] = src[ia:ia + n_m, jb:jb + n_x] * scale
-    return np.einsum("ab,mnbc,dc->mnad", _M, F, _M)
+def _cells(v, d, xk):
+    """Per-cell polynomial coefficients (n_m, n_x, 16), index 4 p + q of tm^p tx^q, of the
+    B-spline (h_min) x cubic Hermite (x) surface with control rows v, d (n_m + 3, n_x + 1)."""
+    dx = np.diff(xk)
+    y0, y1 = v[:, :-1], v[:, 1:]
+    m0, m1 = d[:, :-1] * dx, d[:, 1:] * dx
+    dy = y1 - y0
+    H = np.stack([y0, m0, 3.0 * dy - 2.0 * m0 - m1, -2.0 * dy + m0 + m1], axis=-1)
+    n_m = v.shape[0] - 3
+    Hw = np.stack([H[a:a + n_m] for a in range(4)], axis=0)        # (4, n_m, n_x, 4)
+    C = np.einsum("ap,amjq->mjpq", _B, Hw)
+    return C.reshape(n_m, dx.size, 16)
 
 
-def _eval_cells(C, i, j, tm, tx, second=False):
-    """Value, d/dtx (and d2/dtx2) of the bicubic cells C[i, j] at (tm, tx)."""
-    c = C[i, j]                                           # (n, 4, 4)
-    Tm = np.stack([np.ones_like(tm), tm, tm * tm, tm * tm * tm], axis=-1)
-    g = np.einsum("na,nab->nb", Tm, c)                    # polynomial in tx
-    v = g[:, 0] + tx * (g[:, 1] + tx * (g[:, 2] + tx * g[:, 3]))
-    dv = g[:, 1] + tx * (2.0 * g[:, 2] + tx * 3.0 * g[:, 3])
+def _poly(cc, o, tm, tx, second=False):
+    """Value, d/dtx (and d2/dtx2) of the cell polynomials cc[:, o:o+16] at (tm, tx)."""
+    g = [cc[:, o + q] + tm * (cc[:, o + 4 + q] + tm * (cc[:, o + 8 + q] + tm * cc[:, o + 12 + q]))
+         for q in range(4)]
+    v = g[0] + tx * (g[1] + tx * (g[2] + tx * g[3]))
+    dv = g[1] + tx * (2.0 * g[2] + tx * (3.0 * g[3]))
     if second:
-        return v, dv, 2.0 * g[:, 2] + 6.0 * tx * g[:, 3]
+        return v, dv, 2.0 * g[2] + 6.0 * tx * g[3]
     return v, dv
+
+
+def _hermite_mid(v, d, xk):
+    """Value and x-slope of the cubic Hermite curves (rows of v, d) at the cell midpoints."""
+    dx = np.diff(xk)
+    y0, y1, m0, m1 = v[:, :-1], v[:, 1:], d[:, :-1], d[:, 1:]
+    val = 0.5 * (y0 + y1) + 0.125 * dx * (m0 - m1)
+    der = 1.5 * (y1 - y0) / dx - 0.25 * (m0 + m1)
+    return val, der
+
+
+def _rel_errors(r, dr, la, ref, tail):
+    """Worst relative error of p, k, A/A0 (table rho, d rho/dx, ln a/a0 against the model's
+    (rho, d rho/dx, ln a/a0)), over the points where the model's rho >= ln(tail)."""
+    rr, drr, lar = ref
+    use = rr >= math.log(tail)
+    if not use.any():
+        return 0.0
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        ek = np.where(drr < 0, np.abs(np.exp(r - rr) * dr / drr - 1.0), np.inf)
+    e = np.maximum.reduce([np.abs(np.expm1(r - rr)), ek, np.abs(np.expm1(la - lar))])
+    return float(e[use].max())
 
 
 @dataclass(frozen=True, eq=False)
@@ -133,10 +159,14 @@ class HistoryNormalLaw:
     sigma: float = 1.0
     _hm0: float = 0.0                   # first row h_min [mm]
     _dm: float = 1.0                    # row spacing [mm]
-    _dx: float = 1.0                    # x spacing [-]
     _X: float = 0.0                     # end of the x table [-]
-    _C: Optional[np.ndarray] = None     # (n_m, n_x, 4, 4) bicubic cells of rho
-    _CA: Optional[np.ndarray] = None    # same for ln(a/a0)
+    _xk: Optional[np.ndarray] = None    # (n_x + 1,) x knots (graded) [-]
+    _xinv: Optional[np.ndarray] = None  # (n_x,) 1/knot spacing
+    _xnext: Optional[np.ndarray] = None  # (n_x,) right end of each x cell (inf for the last)
+    _lut: Optional[np.ndarray] = None   # O(1) x look-up: cell index per LUT cell
+    _lut_inv: float = 1.0               # LUT cells per unit x
+    _CF: Optional[np.ndarray] = None    # (n_m n_x, 32) cell coefficients of rho | ln(a/a0)
+    _n_m: int = 0                       # row cells
     _D: Optional[np.ndarray] = None     # (n_m + 1,) D(h_min) at the rows [N/mm]
     _dD: Optional[np.ndarray] = None    # (n_m + 1,) dD/dh_min at the rows (monotone slopes)
     _IL: float = 0.0                    # int exp(rho(row 0, x)) dx incl. taper [-]
@@ -145,7 +175,7 @@ class HistoryNormalLaw:
     # ------------------------------------------------------------ NormalLaw interface
     @property
     def reversible(self) -> bool:
-        return self._C is None
+        return self._CF is None
 
     @property
     def h_min(self) -> float:
@@ -182,7 +212,7 @@ class HistoryNormalLaw:
 
     @classmethod
     def elasto_plastic(cls, surface, material, rtol: float = 1e-4, *, loading=None,
-                       n_quad: int = 16, n_t: int = 16, n_rows: int = 8, n_x: int = 8,
+                       n_quad: int = 16, n_t: int = 16, n_rows: int = 4, n_x: int = 8,
                        tail: float = 1e-12, max_points: int = 20000,
                        max_seconds: float = 600.0, strict: bool = True) -> "HistoryNormalLaw":
         """Table of the elasto-plastic population with memory (reading "consistent").
@@ -190,12 +220,15 @@ class HistoryNormalLaw:
         Args:
             surface: SpectralMoments; material: AsperityMaterial (resolved on surface here).
             rtol: relative accuracy of p, k and A/A0 on the unloading branch against the direct
-                sums (``micro.unloading._row_sums`` with the same n_quad, n_t) at the midpoints
-                of the grid in both directions, in [1e-8, 0.1].
+                sums (``micro.unloading._row_sums`` with the same n_quad, n_t), in [1e-8, 0.1];
+                half of it is given to the x direction (cell midpoints on the first rows), half
+                to the h_min direction (row midpoints at every x knot).
             loading: a prebuilt ``NormalLaw.elasto_plastic`` of the same surface and material
                 (its build time is then not counted); None builds one at rtol.
             n_quad, n_t: quadrature of the direct sums (shape rule, height nodes per panel).
-            n_rows, n_x: initial numbers of h_min and x intervals (doubled as needed).
+            n_rows: initial number of h_min intervals (>= 3; doubled as needed); these rows
+                also decide the graded x knots.
+            n_x: initial number of uniform x intervals (>= 2; a failing interval is split).
             tail: the x table ends where the first row's p/p_load(h_min) < tail; check points
                 below tail are not checked.
             max_points, max_seconds: budget (direct-sum points; wall time [s]).
@@ -208,9 +241,9 @@ class HistoryNormalLaw:
         t0 = time.perf_counter()
         rtol = check_scalar("rtol", rtol, lo=1e-8, hi=0.1, lo_open=False, hi_open=False)
         tail = check_scalar("tail", tail, lo=0.0, hi=1e-2)
-        for name, v in (("n_rows", n_rows), ("n_x", n_x)):
-            if int(v) != v or v < 2:
-                raise ValueError(f"{name} = {v!r} is invalid: it must be an integer >= 2")
+        for name, v, lo in (("n_rows", n_rows, 3), ("n_x", n_x, 2)):
+            if int(v) != v or v < lo:
+                raise ValueError(f"{name} = {v!r} is invalid: it must be an integer >= {lo}")
         mat = material.resolve(surface)
         if loading is None:
             loading = NormalLaw.elasto_plastic(surface, mat, rtol)
@@ -222,7 +255,8 @@ class HistoryNormalLaw:
         n_pts = [0]
 
         def model(hms, xs):
-            """(rho, d rho/dx, ln a - ln a0, d ln a/dx) on rows hms x xs, cached per point."""
+            """(rho, d rho/dx, ln a - ln a0, d ln a/dx) (4, len(hms), len(xs)), cached per
+            point; one direct-sum call per row for the points not yet known."""
             out = np.empty((4, len(hms), len(xs)))
             for i, hm in enumerate(hms):
                 row = cache.setdefault(round(float((hm - hL) / (hE - hL)), 12), {})
@@ -242,100 +276,115 @@ class HistoryNormalLaw:
                     out[:, i, j] = row[round(float(x), 12)]
             return out
 
-        # x range: first row (slowest decay) down to tail
-        X = 2.0
+        # x range: the first row (slowest decay) down to tail, one direct-sum call
+        Xs = 2.0 * 1.5 ** np.arange(9)
         try:
-            while model([hL], [X])[0, 0, 0] > math.log(tail) and X < 64:
-                X *= 1.5
+            r0 = model([hL], Xs)[0, 0]
         except _Budget:
             raise RuntimeError("HistoryNormalLaw: budget exhausted while scanning the x range")
-        nm, nx = int(n_rows), int(n_x)
-        worst = np.inf
+        below = np.flatnonzero(r0 <= math.log(tail))
+        X = float(Xs[below[0]] if below.size else Xs[-1])
+        nm = int(n_rows)
+        xk = np.linspace(0.0, X, int(n_x) + 1)
+        worst_x = worst_m = np.inf
         table = None
-        while True:
-            try:
+        stage = "x"
+        try:
+            # 1. graded x knots: split every x cell whose midpoint fails on any of the first rows
+            rows0 = np.linspace(hL, hE, nm + 1)
+            passed: set = set()
+            while True:
+                m = model(rows0, xk)
+                xm = 0.5 * (xk[:-1] + xk[1:])
+                todo = [j for j in range(xm.size) if round(float(xm[j]), 12) not in passed]
+                worst_x = 0.0
+                split = []
+                if todo:
+                    ref = model(rows0, xm[todo])
+                    v, dv = _hermite_mid(m[0], m[1], xk)
+                    va, _ = _hermite_mid(m[2], m[3], xk)
+                    for c, j in enumerate(todo):
+                        e = _rel_errors(v[:, j], dv[:, j], va[:, j], ref[:3, :, c], tail)
+                        if e > 0.5 * rtol:
+                            split.append(xm[j])
+                        else:
+                            passed.add(round(float(xm[j]), 12))
+                            worst_x = max(worst_x, e)
+                if not split:
+                    break
+                worst_x = np.inf
+                xk = np.sort(np.concatenate([xk, split]))
+            # 2. rows: doubled until the row midpoints pass at every x knot
+            stage = "rows"
+            while True:
                 hm = np.linspace(hL, hE, nm + 1)
-                xs = np.linspace(0.0, X, nx + 1)
-                m = model(hm, xs)
-                table = (hm, xs, m)
-                # checks: x midpoints on the rows, row midpoints at the x knots
-                xmid = 0.5 * (xs[:-1] + xs[1:])
+                m = model(hm, xk)
+                table = (hm, m)
                 hmid = 0.5 * (hm[:-1] + hm[1:])
-                ex = cls._check(m, hm, xs, model(hm, xmid), hm, xmid, tail)
-                em = cls._check(m, hm, xs, model(hmid, xs), hmid, xs, tail)
-            except _Budget:
-                if strict or table is None:
-                    raise RuntimeError(
-                        f"HistoryNormalLaw: budget (max_points = {max_points}, max_seconds = "
-                        f"{max_seconds}) exhausted at rtol = {rtol}; reached {worst:.2g} with "
-                        f"{nm} x {nx} intervals: loosen rtol or raise the budget") from None
-                break
-            worst = max(ex, em)
-            if worst <= rtol:
-                break
-            if ex > rtol:
-                nx *= 2
-            if em > rtol:
+                ref = model(hmid, xk)
+                law = cls._assemble(loading, rtol, sig, hm, xk, m, surface, energy=False)
+                H = np.repeat(hmid, xk.size)
+                Xq = np.tile(xk, hmid.size)
+                r, dr, la = law._rho(H, Xq)
+                worst_m = _rel_errors(r, dr, la, [q.ravel() for q in ref[:3]], tail)
+                if worst_m <= 0.5 * rtol:
+                    break
                 nm *= 2
-        hm, xs, m = table
-        law = cls._assemble(loading, rtol, sig, hm, xs, m, surface)
+        except _Budget:
+            if strict or table is None:
+                raise RuntimeError(
+                    f"HistoryNormalLaw: budget (max_points = {max_points}, max_seconds = "
+                    f"{max_seconds}) exhausted at rtol = {rtol} while refining {stage} "
+                    f"({nm} rows intervals x {xk.size - 1} x intervals; x check error "
+                    f"{worst_x:.2g}): loosen rtol or raise the budget") from None
+        hm, m = table
+        law = cls._assemble(loading, rtol, sig, hm, xk, m, surface)
         ok = law._check_monotone()
+        worst = worst_x + worst_m
         law.info.update({"build_seconds": time.perf_counter() - t0, "loading_seconds": t_load,
                          "history_seconds": time.perf_counter() - t1, "rows": hm.size,
-                         "x_knots": xs.size, "X": X, "model_points": n_pts[0],
-                         "worst_error": float(worst), "n_quad": n_quad, "n_t": n_t,
-                         "k_nonnegative": ok, "reversible": False})
+                         "x_knots": xk.size, "X": X, "model_points": n_pts[0],
+                         "worst_error": float(worst), "worst_error_x": float(worst_x),
+                         "worst_error_h_min": float(worst_m), "n_quad": n_quad, "n_t": n_t,
+                         "k_nonnegative": ok, "reversible": False,
+                         "converged": bool(worst_x <= 0.5 * rtol and worst_m <= 0.5 * rtol)})
         return law
 
     @classmethod
-    def _check(cls, m, hm, xs, ref, hq, xq, tail):
-        """Worst relative error of p, k, a of the grid table (m on hm x xs) at hq x xq."""
-        dm, dx = hm[1] - hm[0], xs[1] - xs[0]
-        C = _bicubic(m[0], m[1], dm, dx)
-        CA = _bicubic(m[2], m[3], dm, dx)
-        H, Xq = np.meshgrid(hq, xq, indexing="ij")
-        H, Xq = H.ravel(), Xq.ravel()
-        i, j, tm, tx = cls._locate(H, Xq, hm[0], dm, dx, hm.size - 1, xs.size - 1)
-        r, dr = _eval_cells(C, i, j, tm, tx)
-        la, _ = _eval_cells(CA, i, j, tm, tx)
-        rr, drr, lar = (ref[q].ravel() for q in range(3))
-        use = rr > math.log(tail)
-        if not use.any():
-            return 0.0
-        with np.errstate(divide="ignore", invalid="ignore"):
-            ek = np.where(drr < 0, np.abs(np.exp(r - rr) * (dr / dx) / drr - 1.0), np.inf)
-        e = np.maximum.reduce([np.abs(np.expm1(r - rr)), ek, np.abs(np.expm1(la - lar))])
-        return float(e[use].max())
-
-    @staticmethod
-    def _locate(hm, x, h0, dm, dx, n_m, n_x):
-        um = np.clip((hm - h0) / dm, 0.0, n_m)
-        i = np.minimum(um.astype(np.intp), n_m - 1)
-        ux = np.clip(x / dx, 0.0, n_x)
-        j = np.minimum(ux.astype(np.intp), n_x - 1)
-        return i, j, um - i, ux - j
-
-    @classmethod
-    def _assemble(cls, loading, rtol, sig, hm, xs, m, surface):
-        dm, dx = float(hm[1] - hm[0]), float(xs[1] - xs[0])
-        C = _bicubic(m[0], m[1], dm, dx)
-        CA = _bicubic(m[2], m[3], dm, dx)
-        n_m = hm.size - 1
+    def _assemble(cls, loading, rtol, sig, hm, xk, m, surface, energy=True):
+        """The law from row data m (4, n_rows, n_knots) on rows hm and x knots xk."""
+        n_m, n_x = hm.size - 1, xk.size - 1
+        dm = float(hm[1] - hm[0])
+        cv, cd, ch1 = _monotone_controls(*_spline_controls(np.stack([m[0], m[1]], 1)
+                                                             ).transpose(1, 0, 2), xk)
+        av, ad, ch2 = _monotone_controls(*_spline_controls(np.stack([m[2], m[3]], 1)
+                                                             ).transpose(1, 0, 2), xk)
+        CF = np.concatenate([_cells(cv, cd, xk), _cells(av, ad, xk)], axis=2)
+        CF = np.ascontiguousarray(CF.reshape(n_m * n_x, 32))
+        dxk = np.diff(xk)
+        w = float(dxk.min())
+        n_lut = int(round(float(xk[-1]) / w))
+        lut = np.clip(np.searchsorted(xk, (np.arange(n_lut + 1) + 0.5) * w, side="right") - 1,
+                      0, n_x - 1).astype(np.intp)
+        nxt = np.concatenate([xk[1:-1], [np.inf]])
+        law = cls(loading=loading, rtol=rtol, sigma=sig, _hm0=float(hm[0]), _dm=dm,
+                  _X=float(xk[-1]), _xk=xk, _xinv=1.0 / dxk, _xnext=nxt, _lut=lut,
+                  _lut_inv=1.0 / w, _CF=CF, _n_m=n_m,
+                  info={"monotone_projection_changes": ch1 + ch2})
+        if not energy:
+            return law
         # recoverable energy per row: sigma p0 int exp(rho) dx (Gauss-Legendre per x cell, on
         # the interpolant itself) + the taper's p_X L/4
-        g, w = np.polynomial.legendre.leggauss(8)
-        g, w = 0.5 * (g + 1.0), 0.5 * w
-        n_x = xs.size - 1
+        g, wg = np.polynomial.legendre.leggauss(8)
+        g, wg = 0.5 * (g + 1.0), 0.5 * wg
+        xq = (xk[:-1, None] + dxk[:, None] * g).ravel()
+        wq = (dxk[:, None] * wg).ravel()
         I = np.zeros(n_m + 1)
         for r in range(n_m + 1):
-            i = np.full(n_x * g.size, min(r, n_m - 1))
-            tm = np.full(i.size, 1.0 if r == n_m else 0.0)
-            j = np.repeat(np.arange(n_x), g.size)
-            tx = np.tile(g, n_x)
-            v, _ = _eval_cells(C, i, j, tm, tx)
-            I[r] = dx * np.sum(np.tile(w, n_x) * np.exp(v))
-            vX, dvX = _eval_cells(C, i[-1:], j[-1:], tm[-1:], np.ones(1))
-            pX, kX = math.exp(vX[0]), -math.exp(vX[0]) * dvX[0] / dx      # per unit x
+            v, _, _ = law._rho(np.full(xq.size, hm[r]), xq)
+            I[r] = np.sum(wq * np.exp(v))
+            vX, dvX, _ = law._rho(np.full(1, hm[r]), np.full(1, xk[-1]))
+            pX, kX = math.exp(vX[0]), -math.exp(vX[0]) * dvX[0]      # per unit x
             if kX > 0:
                 I[r] += pX * (3.0 * pX / kX) / 4.0
         p0 = loading.evaluate(hm)[0]
@@ -344,10 +393,34 @@ class HistoryNormalLaw:
         D = np.maximum(W - E_rec, 0.0)
         D[-1] = 0.0
         dD = _pchip_slopes(hm, D)
-        law = cls(loading=loading, rtol=rtol, sigma=sig, _hm0=float(hm[0]), _dm=dm, _dx=dx,
-                  _X=float(xs[-1]), _C=C, _CA=CA, _D=D, _dD=dD, _IL=float(I[0]),
-                  info={"recoverable_energy_rows": E_rec, "work_rows": W})
+        object.__setattr__(law, "_D", D)
+        object.__setattr__(law, "_dD", dD)
+        object.__setattr__(law, "_IL", float(I[0]))
+        law.info.update({"recoverable_energy_rows": E_rec, "work_rows": W})
         return law
+
+    def _cell(self, hm, x):
+        """Cell index and local coordinates (tm, tx) of the points (h_min, x), x in [0, X]."""
+        um = (hm - self._hm0) * (1.0 / self._dm)
+        np.clip(um, 0.0, self._n_m, out=um)
+        i = np.minimum(um.astype(np.intp), self._n_m - 1)
+        um -= i
+        j = self._lut.take((x * self._lut_inv).astype(np.intp))
+        j += x >= self._xnext.take(j)
+        tx = x - self._xk.take(j)
+        tx *= self._xinv.take(j)
+        i *= self._xinv.size
+        i += j
+        return i, j, um, tx
+
+    def _rho(self, hm, x):
+        """(rho, d rho/dx, ln a/a0) of the table at (h_min, x), x clipped to [0, X]."""
+        x = np.clip(x, 0.0, self._X)
+        c, j, tm, tx = self._cell(np.asarray(hm, float).copy(), x)
+        cc = self._CF[c]
+        r, dr = _poly(cc, 0, tm, tx)
+        la, _ = _poly(cc, 16, tm, tx)
+        return r, dr * self._xinv.take(j), la
 
     def _check_monotone(self, n: int = 200_000) -> bool:
         rng = np.random.default_rng(1)
@@ -367,32 +440,37 @@ class HistoryNormalLaw:
         h, hmn = np.broadcast_arrays(h, hmn)
         shape = h.shape
         h, hmn = h.ravel(), hmn.ravel()
-        if self._C is None:                       # reversible: h_min has no effect
+        if self._CF is None:                      # reversible: h_min has no effect
             return tuple(v.reshape(shape) for v in self.loading.evaluate(h, curvature))
         # one loading evaluation: at h on the loading branch, at h_min (the branch's p0) else
         out = self.loading.evaluate(np.minimum(h, hmn), curvature)
         out = [np.array(v, dtype=float).ravel() for v in out]
         un = np.flatnonzero((h > hmn) & (hmn < self.h_table_end))
-        if un.size:
-            self._unload(h.take(un), hmn.take(un), [v.take(un) for v in out], out, un,
-                         curvature)
+        for s in range(0, un.size, _BLOCK):
+            idx = un[s:s + _BLOCK]
+            self._unload(h.take(idx), hmn.take(idx), out, idx, curvature)
         return tuple(v.reshape(shape) for v in out)
 
-    def _unload(self, h, hm, base, out, idx, curvature):
-        p0, a0 = base[0], base[2]
-        sig, dx = self.sigma, self._dx
-        n_m, n_x = self._C.shape[0], self._C.shape[1]
-        x = (h - hm) / sig
+    def _unload(self, h, hm, out, idx, curvature):
+        p0, a0 = out[0].take(idx), out[2].take(idx)
+        sig = self.sigma
+        x = h - hm
+        x *= 1.0 / sig
         xc = np.minimum(x, self._X)
-        i, j, tm, tx = self._locate(hm, xc, self._hm0, self._dm, dx, n_m, n_x)
-        r = _eval_cells(self._C, i, j, tm, tx, second=curvature)
-        la, _ = _eval_cells(self._CA, i, j, tm, tx)
-        p = p0 * np.exp(r[0])
-        k = -p * r[1] / (dx * sig)
-        a = a0 * np.exp(la)
+        c, j, tm, tx = self._cell(hm, xc)
+        cc = self._CF[c]
+        r = _poly(cc, 0, tm, tx, second=curvature)
+        la, _ = _poly(cc, 16, tm, tx)
+        s = self._xinv.take(j)
+        s *= 1.0 / sig                            # d tx/dh
+        p = np.exp(r[0])
+        p *= p0
+        d1 = r[1] * s                             # d rho/dh
+        k = -p * d1
+        a = np.exp(la)
+        a *= a0
         if curvature:
-            d1 = r[1] / (dx * sig)
-            dk = -p * (r[2] / (dx * sig) ** 2 + d1 * d1)
+            dk = -p * (r[2] * s * s + d1 * d1)
         tp = x > self._X
         if tp.any():
             pe, ke, ae = p[tp], k[tp], a[tp]
@@ -411,7 +489,7 @@ class HistoryNormalLaw:
         """D(h_min) [N/mm] (module doc): cubic Hermite with monotone slopes through the rows'
         values; below the table the first row's branch shape scaled by p_load(h_min)."""
         hm = np.asarray(h_min, dtype=float)
-        if self._C is None:
+        if self._CF is None:
             return np.zeros(hm.shape)
         flat = hm.ravel()
         out = np.zeros(flat.size)
