@@ -182,11 +182,12 @@ _SCAN_T = 6           # height nodes per half-panel of the scan
 _LOG_CUT = 34.0       # windows keep the integrand above exp(-34) of its maximum
 
 
-def _invert_delta_e(tau, tc, tp, kappa, f1, f2, f3, wc, wp, mat, smu, n_iter=48):
+def _invert_delta_e(tau, tc, tp, kappa, f1, f2, f3, wc, wp, mat, smu, n_iter=20):
     """Smallest t2 >= tc with delta_e(smu t2) >= smu tau on the ZMC/plastic branch (t units).
 
     delta_e is increasing on [omega_c, inf) (checked in the tests); plastic branch in closed
-    form (delta_e = C sqrt(W)), the ZMC branch by bisection (only where it is needed).
+    form (delta_e = C sqrt(W)), the ZMC branch by bisection (only where it is needed), ended by
+    a linear interpolation in the last bracket.
     """
     Es = mat.E_star
     # plastic: delta_e = 1.5 ch H A/S(A) = C_p sqrt(W)
@@ -204,13 +205,20 @@ def _invert_delta_e(tau, tc, tp, kappa, f1, f2, f3, wc, wp, mat, smu, n_iter=48)
         Z = lambda x: np.broadcast_to(x, shape)[zmc]   # noqa: E731
         ka, g1, g2, g3, c, p_, ta = Z(kappa), Z(f1), Z(f2), Z(f3), Z(wc), Z(wp), Z(tau)
         lo_, hi_ = Z(tc).copy(), Z(tp).copy()
+        target = smu * ta
+        flo, fhi = Z(dec) - target, Z(dep) - target          # < 0 and > 0
         for _ in range(n_iter):
             mid = 0.5 * (lo_ + hi_)
-            A, P, _ = _loading(smu * mid, ka, g1, g2, g3, c, p_, mat)
-            up = _delta_e(smu * mid, A, P, g1, g2, Es) < smu * ta
-            lo_ = np.where(up, mid, lo_)
-            hi_ = np.where(up, hi_, mid)
-        hi[zmc] = hi_
+            A, _ = zmc_area(smu * mid, ka, g1, g3, c, p_)      # ZMC branch only
+            P = A * zmc_mean_pressure(smu * mid, c, mat)[0]
+            f = _delta_e(smu * mid, A, P, g1, g2, Es) - target
+            up = f < 0
+            lo_, flo = np.where(up, mid, lo_), np.where(up, f, flo)
+            hi_, fhi = np.where(up, hi_, mid), np.where(up, fhi, f)
+        # linear interpolation in the last bracket (error ~ bracket^2)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            lin = lo_ - flo * (hi_ - lo_) / (fhi - flo)
+        hi[zmc] = np.where(np.isfinite(lin), np.clip(lin, lo_, hi_), hi_)
     return np.where(smu * tau <= dec, tc, np.where(smu * tau >= dep, np.maximum(tpl, tp), hi))
 
 
@@ -277,7 +285,10 @@ def _node_integrals(C, l, tau, K, zeta, n_t):
     x, w = _pop._gl01(n_t)
     out = [np.zeros(K.size) for _ in range(4)]
     t2p = np.maximum(t2, tp)
-    for t0, b in ((tau, np.minimum(tc, t_hi)), (t2, np.minimum(tp, t_hi)), (t2p, t_hi)):
+    # each height panel lies in one regime of the loading law (elastic, ZMC, plastic): the
+    # summit's (A, P, delta_e) are evaluated with that regime's formula only
+    for regime, t0, b in ((0, tau, np.minimum(tc, t_hi)), (1, t2, np.minimum(tp, t_hi)),
+                          (2, t2p, t_hi)):
         live = np.flatnonzero(b > t0)
         if not live.size:
             continue
@@ -286,14 +297,27 @@ def _node_integrals(C, l, tau, K, zeta, n_t):
         vb = np.sqrt(b.take(live) - T0)
         vpk = np.clip(np.sqrt(np.maximum(-dl - T0, 0.0)), 0.0, vb)
         acc = [np.zeros(live.size) for _ in range(4)]
+        cA = np.pi / ka
+        if regime == 0:
+            cP = 4.0 / 3.0 * Es * g2 / np.sqrt(ka)
+        else:   # S(A) = cS sqrt(A)
+            cS = 2.0 * Es * (g2 / np.sqrt(g1)) / math.sqrt(math.pi)
         for lo, hi in ((0.0, vpk), (vpk, vb)):
             for j in range(n_t):
                 v = lo + (hi - lo) * x[j]
                 t = T0 + v * v
                 jac = 2.0 * v * (hi - lo) * w[j]
                 W = smu * t
-                A, P, _ = _loading(W, ka, g1, g2, g3, c, q, mat)
-                de = np.where(W < c, W, _delta_e(W, A, P, g1, g2, Es))
+                if regime == 0:
+                    A, P, de = g1 * cA * W, cP * W ** 1.5, W
+                elif regime == 1:
+                    A, _ = zmc_area(W, ka, g1, g3, c, q)
+                    P = A * zmc_mean_pressure(np.clip(W, c, q), c, mat)[0]
+                    de = np.minimum(1.5 * P / (cS * np.sqrt(A)), W)
+                else:
+                    A = 2.0 * g3 * cA * W
+                    P = mat.ch * mat.H * A
+                    de = np.minimum(1.5 * P / (cS * np.sqrt(A)), W)
                 with np.errstate(divide="ignore", invalid="ignore"):
                     xi = np.clip(np.where(de > 0, 1.0 - smu * ta / de, 0.0), 0.0, 1.0)
                     ide = np.where((xi > 0) & (de > 0), 1.0 / de, 0.0)
