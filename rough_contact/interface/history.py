@@ -54,7 +54,7 @@ __all__ = ["HistoryNormalLawProtocol", "HistoryNormalLaw"]
 # b_a(tm) = sum_p _B[a, p] tm^p >= 0 and sum_a b_a = 1 (a convex combination of 4 control rows).
 _B = np.array([[1.0, -3.0, 3.0, -1.0], [4.0, 0.0, -6.0, 3.0], [1.0, 3.0, 3.0, -3.0],
                [0.0, 0.0, 0.0, 1.0]]) / 6.0
-_BLOCK = 4096
+_BLOCK = 8192        # points per evaluation block (about half of them on the unloading branch)
 
 
 def _spline_controls(V):
@@ -110,15 +110,31 @@ def _cells(v, d, xk):
     return C.reshape(n_m, dx.size, 16)
 
 
-def _poly(cc, o, tm, tx, second=False):
-    """Value, d/dtx (and d2/dtx2) of the cell polynomials cc[:, o:o+16] at (tm, tx)."""
-    g = [cc[:, o + q] + tm * (cc[:, o + 4 + q] + tm * (cc[:, o + 8 + q] + tm * cc[:, o + 12 + q]))
-         for q in range(4)]
-    v = g[0] + tx * (g[1] + tx * (g[2] + tx * g[3]))
-    dv = g[1] + tx * (2.0 * g[2] + tx * (3.0 * g[3]))
+def _poly(cc, tm, tx, second=False):
+    """rho, d rho/dtx (and d2 rho/dtx2) and ln(a/a0) of the gathered cell coefficients cc
+    (32, n) at (tm, tx) (Horner in tm for both tables at once, then in tx)."""
+    c4 = cc.reshape(2, 4, 4, -1)                          # [k, p, q, point]
+    g = c4[:, 3] * tm
+    g += c4[:, 2]
+    g *= tm
+    g += c4[:, 1]
+    g *= tm
+    g += c4[:, 0]                                         # (2, 4, n): polynomials in tx
+    v = g[:, 3] * tx
+    v += g[:, 2]
+    v *= tx
+    v += g[:, 1]
+    v *= tx
+    v += g[:, 0]
+    dv = g[0, 3] * (3.0 * tx)
+    dv += 2.0 * g[0, 2]
+    dv *= tx
+    dv += g[0, 1]
     if second:
-        return v, dv, 2.0 * g[2] + 6.0 * tx * g[3]
-    return v, dv
+        d2 = g[0, 3] * (6.0 * tx)
+        d2 += 2.0 * g[0, 2]
+        return v[0], dv, v[1], d2
+    return v[0], dv, v[1]
 
 
 def _hermite_mid(v, d, xk):
@@ -162,10 +178,12 @@ class HistoryNormalLaw:
     _X: float = 0.0                     # end of the x table [-]
     _xk: Optional[np.ndarray] = None    # (n_x + 1,) x knots (graded) [-]
     _xinv: Optional[np.ndarray] = None  # (n_x,) 1/knot spacing
+    _xinv_h: Optional[np.ndarray] = None  # (n_x,) 1/(knot spacing sigma) [1/mm]
     _xnext: Optional[np.ndarray] = None  # (n_x,) right end of each x cell (inf for the last)
     _lut: Optional[np.ndarray] = None   # O(1) x look-up: cell index per LUT cell
     _lut_inv: float = 1.0               # LUT cells per unit x
-    _CF: Optional[np.ndarray] = None    # (n_m n_x, 32) cell coefficients of rho | ln(a/a0)
+    _CF: Optional[np.ndarray] = None    # (32, n_m n_x) cell coefficients, row 16 k + 4 p + q:
+    #                                     k = 0 rho, 1 ln(a/a0); of tm^p tx^q
     _n_m: int = 0                       # row cells
     _D: Optional[np.ndarray] = None     # (n_m + 1,) D(h_min) at the rows [N/mm]
     _dD: Optional[np.ndarray] = None    # (n_m + 1,) dD/dh_min at the rows (monotone slopes)
@@ -222,7 +240,7 @@ class HistoryNormalLaw:
             rtol: relative accuracy of p, k and A/A0 on the unloading branch against the direct
                 sums (``micro.unloading._row_sums`` with the same n_quad, n_t), in [1e-8, 0.1];
                 half of it is given to the x direction (cell midpoints on the first rows), half
-                to the h_min direction (row midpoints at every x knot).
+                to the h_min direction (row midpoints at every other x knot).
             loading: a prebuilt ``NormalLaw.elasto_plastic`` of the same surface and material
                 (its build time is then not counted); None builds one at rtol.
             n_quad, n_t: quadrature of the direct sums (shape rule, height nodes per panel).
@@ -314,17 +332,19 @@ class HistoryNormalLaw:
                     break
                 worst_x = np.inf
                 xk = np.sort(np.concatenate([xk, split]))
-            # 2. rows: doubled until the row midpoints pass at every x knot
+            # 2. rows: doubled until the row midpoints pass at every other x knot (and the
+            #    last); the checked points become knots of the next rows if they fail
             stage = "rows"
+            xc = xk[np.unique(np.r_[np.arange(0, xk.size, 2), xk.size - 1])]
             while True:
                 hm = np.linspace(hL, hE, nm + 1)
                 m = model(hm, xk)
                 table = (hm, m)
                 hmid = 0.5 * (hm[:-1] + hm[1:])
-                ref = model(hmid, xk)
+                ref = model(hmid, xc)
                 law = cls._assemble(loading, rtol, sig, hm, xk, m, surface, energy=False)
-                H = np.repeat(hmid, xk.size)
-                Xq = np.tile(xk, hmid.size)
+                H = np.repeat(hmid, xc.size)
+                Xq = np.tile(xc, hmid.size)
                 r, dr, la = law._rho(H, Xq)
                 worst_m = _rel_errors(r, dr, la, [q.ravel() for q in ref[:3]], tail)
                 if worst_m <= 0.5 * rtol:
@@ -360,7 +380,7 @@ class HistoryNormalLaw:
         av, ad, ch2 = _monotone_controls(*_spline_controls(np.stack([m[2], m[3]], 1)
                                                              ).transpose(1, 0, 2), xk)
         CF = np.concatenate([_cells(cv, cd, xk), _cells(av, ad, xk)], axis=2)
-        CF = np.ascontiguousarray(CF.reshape(n_m * n_x, 32))
+        CF = np.ascontiguousarray(CF.reshape(n_m * n_x, 32).T)
         dxk = np.diff(xk)
         w = float(dxk.min())
         n_lut = int(round(float(xk[-1]) / w))
@@ -368,7 +388,8 @@ class HistoryNormalLaw:
                       0, n_x - 1).astype(np.intp)
         nxt = np.concatenate([xk[1:-1], [np.inf]])
         law = cls(loading=loading, rtol=rtol, sigma=sig, _hm0=float(hm[0]), _dm=dm,
-                  _X=float(xk[-1]), _xk=xk, _xinv=1.0 / dxk, _xnext=nxt, _lut=lut,
+                  _X=float(xk[-1]), _xk=xk, _xinv=1.0 / dxk, _xinv_h=1.0 / (dxk * sig),
+                  _xnext=nxt, _lut=lut,
                   _lut_inv=1.0 / w, _CF=CF, _n_m=n_m,
                   info={"monotone_projection_changes": ch1 + ch2})
         if not energy:
@@ -416,10 +437,8 @@ class HistoryNormalLaw:
     def _rho(self, hm, x):
         """(rho, d rho/dx, ln a/a0) of the table at (h_min, x), x clipped to [0, X]."""
         x = np.clip(x, 0.0, self._X)
-        c, j, tm, tx = self._cell(np.asarray(hm, float).copy(), x)
-        cc = self._CF[c]
-        r, dr = _poly(cc, 0, tm, tx)
-        la, _ = _poly(cc, 16, tm, tx)
+        c, j, tm, tx = self._cell(np.asarray(hm, float), x)
+        r, dr, la = _poly(self._CF.take(c, axis=1), tm, tx)
         return r, dr * self._xinv.take(j), la
 
     def _check_monotone(self, n: int = 200_000) -> bool:
@@ -442,37 +461,43 @@ class HistoryNormalLaw:
         h, hmn = h.ravel(), hmn.ravel()
         if self._CF is None:                      # reversible: h_min has no effect
             return tuple(v.reshape(shape) for v in self.loading.evaluate(h, curvature))
-        # one loading evaluation: at h on the loading branch, at h_min (the branch's p0) else
-        out = self.loading.evaluate(np.minimum(h, hmn), curvature)
-        out = [np.array(v, dtype=float).ravel() for v in out]
-        un = np.flatnonzero((h > hmn) & (hmn < self.h_table_end))
-        for s in range(0, un.size, _BLOCK):
-            idx = un[s:s + _BLOCK]
-            self._unload(h.take(idx), hmn.take(idx), out, idx, curvature)
+        # one loading evaluation per point, at min(h, h_min): the loading branch where h <=
+        # h_min, else the branch's start p0 = p_load(h_min), a0; in blocks that stay in cache
+        n = h.size
+        out = [np.empty(n) for _ in range(4 if curvature else 3)]
+        load_block, h_end = self.loading._eval_block, self.h_table_end
+        for s in range(0, n, _BLOCK):
+            e = min(s + _BLOCK, n)
+            hb, mb = h[s:e], hmn[s:e]
+            ob = [o[s:e] for o in out]
+            load_block(np.minimum(hb, mb), ob[0], ob[1], ob[2], ob[3] if curvature else None)
+            un = np.flatnonzero((hb > mb) & (mb < h_end))
+            if un.size:
+                self._unload(hb.take(un), mb.take(un), ob, un, curvature)
         return tuple(v.reshape(shape) for v in out)
 
     def _unload(self, h, hm, out, idx, curvature):
-        p0, a0 = out[0].take(idx), out[2].take(idx)
+        """The unloading branch at the points idx (h > h_min, h_min < h_table_end) of out,
+        whose loading values there are those at h_min (p0, a0)."""
         sig = self.sigma
         x = h - hm
         x *= 1.0 / sig
         xc = np.minimum(x, self._X)
         c, j, tm, tx = self._cell(hm, xc)
-        cc = self._CF[c]
-        r = _poly(cc, 0, tm, tx, second=curvature)
-        la, _ = _poly(cc, 16, tm, tx)
-        s = self._xinv.take(j)
-        s *= 1.0 / sig                            # d tx/dh
+        r = _poly(self._CF.take(c, axis=1), tm, tx, second=curvature)
         p = np.exp(r[0])
-        p *= p0
-        d1 = r[1] * s                             # d rho/dh
-        k = -p * d1
-        a = np.exp(la)
-        a *= a0
+        p *= out[0].take(idx)
+        d1 = r[1]
+        d1 *= self._xinv_h.take(j)                # d rho/dh = d rho/dtx dtx/dh
+        k = p * d1
+        np.negative(k, out=k)
+        a = np.exp(r[2])
+        a *= out[2].take(idx)
         if curvature:
-            dk = -p * (r[2] * s * s + d1 * d1)
-        tp = x > self._X
-        if tp.any():
+            s = self._xinv_h.take(j)
+            dk = -p * (r[3] * s * s + d1 * d1)
+        if x.max() > self._X:
+            tp = np.flatnonzero(x > self._X)
             pe, ke, ae = p[tp], k[tp], a[tp]
             L = 3.0 * pe / np.maximum(ke, 1e-300)
             t = np.clip((x[tp] - self._X) * sig / L, 0.0, 1.0)
