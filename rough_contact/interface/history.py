@@ -54,7 +54,28 @@ __all__ = ["HistoryNormalLawProtocol", "HistoryNormalLaw"]
 # b_a(tm) = sum_p _B[a, p] tm^p >= 0 and sum_a b_a = 1 (a convex combination of 4 control rows).
 _B = np.array([[1.0, -3.0, 3.0, -1.0], [4.0, 0.0, -6.0, 3.0], [1.0, 3.0, 3.0, -3.0],
                [0.0, 0.0, 0.0, 1.0]]) / 6.0
+_GRADING = 1.0       # row grading beta: row spacing grows 1 + 2 beta = 3x from h_lo to h_end
 _BLOCK = 8192        # points per evaluation block (about half of them on the unloading branch)
+
+
+def _row_h(v, h0, span, beta):
+    """h_min [mm] of the row coordinate v (rows uniform in v; v = 0: h0, v = 1: h0 + span):
+    h_min = h0 + span (v + beta v^2)/(1 + beta), denser rows at small h_min."""
+    v = np.asarray(v, float)
+    return h0 + span * (v + beta * v * v) / (1.0 + beta)
+
+
+def _row_v(h, h0, span, beta):
+    """Inverse of ``_row_h`` on [h0, h0 + span] (h clipped to it)."""
+    s = np.clip((np.asarray(h, float) - h0) * (1.0 / span), 0.0, 1.0)
+    if beta == 0.0:
+        return s
+    s *= 4.0 * beta * (1.0 + beta)
+    s += 1.0
+    np.sqrt(s, out=s)
+    s -= 1.0
+    s *= 1.0 / (2.0 * beta)
+    return s
 
 
 def _spline_controls(V):
@@ -174,7 +195,8 @@ class HistoryNormalLaw:
     rtol: Optional[float]
     sigma: float = 1.0
     _hm0: float = 0.0                   # first row h_min [mm]
-    _dm: float = 1.0                    # row spacing [mm]
+    _span: float = 1.0                  # last row - first row [mm]
+    _beta: float = 0.0                  # row grading (rows uniform in v, module doc)
     _X: float = 0.0                     # end of the x table [-]
     _xk: Optional[np.ndarray] = None    # (n_x + 1,) x knots (graded) [-]
     _xinv: Optional[np.ndarray] = None  # (n_x,) 1/knot spacing
@@ -309,7 +331,8 @@ class HistoryNormalLaw:
         stage = "x"
         try:
             # 1. graded x knots: split every x cell whose midpoint fails on any of the first rows
-            rows0 = np.linspace(hL, hE, nm + 1)
+            span, beta = hE - hL, _GRADING
+            rows0 = _row_h(np.linspace(0.0, 1.0, nm + 1), hL, span, beta)
             passed: set = set()
             while True:
                 m = model(rows0, xk)
@@ -337,12 +360,14 @@ class HistoryNormalLaw:
             stage = "rows"
             xc = xk[np.unique(np.r_[np.arange(0, xk.size, 2), xk.size - 1])]
             while True:
-                hm = np.linspace(hL, hE, nm + 1)
+                # rows uniform in v, with one ghost row beyond each end (interior spline
+                # conditions at the table's ends)
+                hm = _row_h(np.arange(-1, nm + 2) / nm, hL, span, beta)
                 m = model(hm, xk)
                 table = (hm, m)
-                hmid = 0.5 * (hm[:-1] + hm[1:])
+                hmid = _row_h((np.arange(nm) + 0.5) / nm, hL, span, beta)
                 ref = model(hmid, xc)
-                law = cls._assemble(loading, rtol, sig, hm, xk, m, surface, energy=False)
+                law = cls._assemble(loading, rtol, sig, hm, xk, m, beta, energy=False)
                 H = np.repeat(hmid, xc.size)
                 Xq = np.tile(xc, hmid.size)
                 r, dr, la = law._rho(H, Xq)
@@ -358,11 +383,11 @@ class HistoryNormalLaw:
                     f"({nm} rows intervals x {xk.size - 1} x intervals; x check error "
                     f"{worst_x:.2g}): loosen rtol or raise the budget") from None
         hm, m = table
-        law = cls._assemble(loading, rtol, sig, hm, xk, m, surface)
+        law = cls._assemble(loading, rtol, sig, hm, xk, m, beta)
         ok = law._check_monotone()
         worst = worst_x + worst_m
         law.info.update({"build_seconds": time.perf_counter() - t0, "loading_seconds": t_load,
-                         "history_seconds": time.perf_counter() - t1, "rows": hm.size,
+                         "history_seconds": time.perf_counter() - t1, "rows": hm.size - 2,
                          "x_knots": xk.size, "X": X, "model_points": n_pts[0],
                          "worst_error": float(worst), "worst_error_x": float(worst_x),
                          "worst_error_h_min": float(worst_m), "n_quad": n_quad, "n_t": n_t,
@@ -371,15 +396,17 @@ class HistoryNormalLaw:
         return law
 
     @classmethod
-    def _assemble(cls, loading, rtol, sig, hm, xk, m, surface, energy=True):
-        """The law from row data m (4, n_rows, n_knots) on rows hm and x knots xk."""
-        n_m, n_x = hm.size - 1, xk.size - 1
-        dm = float(hm[1] - hm[0])
+    def _assemble(cls, loading, rtol, sig, hm, xk, m, beta, energy=True):
+        """The law from row data m (4, n_m + 3, n_knots) on the rows hm (uniform in v, the
+        first and the last a ghost row beyond the table) and the x knots xk."""
+        n_m, n_x = hm.size - 3, xk.size - 1
         cv, cd, ch1 = _monotone_controls(*_spline_controls(np.stack([m[0], m[1]], 1)
                                                              ).transpose(1, 0, 2), xk)
         av, ad, ch2 = _monotone_controls(*_spline_controls(np.stack([m[2], m[3]], 1)
                                                              ).transpose(1, 0, 2), xk)
-        CF = np.concatenate([_cells(cv, cd, xk), _cells(av, ad, xk)], axis=2)
+        # the spline through all rows; cells of the table's rows only (ghost cells dropped)
+        CF = np.concatenate([_cells(cv[1:-1], cd[1:-1], xk), _cells(av[1:-1], ad[1:-1], xk)],
+                            axis=2)
         CF = np.ascontiguousarray(CF.reshape(n_m * n_x, 32).T)
         dxk = np.diff(xk)
         w = float(dxk.min())
@@ -387,7 +414,9 @@ class HistoryNormalLaw:
         lut = np.clip(np.searchsorted(xk, (np.arange(n_lut + 1) + 0.5) * w, side="right") - 1,
                       0, n_x - 1).astype(np.intp)
         nxt = np.concatenate([xk[1:-1], [np.inf]])
-        law = cls(loading=loading, rtol=rtol, sigma=sig, _hm0=float(hm[0]), _dm=dm,
+        hm = hm[1:-1]
+        law = cls(loading=loading, rtol=rtol, sigma=sig, _hm0=float(hm[0]),
+                  _span=float(hm[-1] - hm[0]), _beta=float(beta),
                   _X=float(xk[-1]), _xk=xk, _xinv=1.0 / dxk, _xinv_h=1.0 / (dxk * sig),
                   _xnext=nxt, _lut=lut,
                   _lut_inv=1.0 / w, _CF=CF, _n_m=n_m,
@@ -413,7 +442,7 @@ class HistoryNormalLaw:
         W = _work_to(loading, hm)
         D = np.maximum(W - E_rec, 0.0)
         D[-1] = 0.0
-        dD = _pchip_slopes(hm, D)
+        dD = _pchip_slopes(np.linspace(0.0, 1.0, n_m + 1), D)      # dD/dv
         object.__setattr__(law, "_D", D)
         object.__setattr__(law, "_dD", dD)
         object.__setattr__(law, "_IL", float(I[0]))
@@ -422,8 +451,8 @@ class HistoryNormalLaw:
 
     def _cell(self, hm, x):
         """Cell index and local coordinates (tm, tx) of the points (h_min, x), x in [0, X]."""
-        um = (hm - self._hm0) * (1.0 / self._dm)
-        np.clip(um, 0.0, self._n_m, out=um)
+        um = _row_v(hm, self._hm0, self._span, self._beta)
+        um *= self._n_m
         i = np.minimum(um.astype(np.intp), self._n_m - 1)
         um -= i
         j = self._lut.take((x * self._lut_inv).astype(np.intp))
@@ -521,11 +550,11 @@ class HistoryNormalLaw:
         n_m = self._D.size - 1
         inside = (flat >= self._hm0) & (flat < self.h_table_end)
         if inside.any():
-            u = (flat[inside] - self._hm0) / self._dm
+            u = _row_v(flat[inside], self._hm0, self._span, self._beta) * n_m
             i = np.minimum(u.astype(np.intp), n_m - 1)
             t = u - i
             y0, y1 = self._D[i], self._D[i + 1]
-            m0, m1 = self._dD[i] * self._dm, self._dD[i + 1] * self._dm
+            m0, m1 = self._dD[i] / n_m, self._dD[i + 1] / n_m
             t2, t3 = t * t, t * t * t
             out[inside] = ((2 * t3 - 3 * t2 + 1) * y0 + (t3 - 2 * t2 + t) * m0
                            + (-2 * t3 + 3 * t2) * y1 + (t3 - t2) * m1)
