@@ -302,6 +302,7 @@ def _node_integrals(C, l, tau, K, zeta, n_t):
             cP = 4.0 / 3.0 * Es * g2 / np.sqrt(ka)
         else:   # S(A) = cS sqrt(A)
             cS = 2.0 * Es * (g2 / np.sqrt(g1)) / math.sqrt(math.pi)
+        uta = smu * ta
         for lo, hi in ((0.0, vpk), (vpk, vb)):
             for j in range(n_t):
                 v = lo + (hi - lo) * x[j]
@@ -309,7 +310,8 @@ def _node_integrals(C, l, tau, K, zeta, n_t):
                 jac = 2.0 * v * (hi - lo) * w[j]
                 W = smu * t
                 if regime == 0:
-                    A, P, de = g1 * cA * W, cP * W ** 1.5, W
+                    A, P = g1 * cA * W, cP * W * np.sqrt(W)
+                    de = np.maximum(W, 1e-300)        # W = 0 only at a node of weight 0
                 elif regime == 1:
                     A, _ = zmc_area(W, ka, g1, g3, c, q)
                     P = A * zmc_mean_pressure(np.clip(W, c, q), c, mat)[0]
@@ -318,14 +320,19 @@ def _node_integrals(C, l, tau, K, zeta, n_t):
                     A = 2.0 * g3 * cA * W
                     P = mat.ch * mat.H * A
                     de = np.minimum(1.5 * P / (cS * np.sqrt(A)), W)
-                with np.errstate(divide="ignore", invalid="ignore"):
-                    xi = np.clip(np.where(de > 0, 1.0 - smu * ta / de, 0.0), 0.0, 1.0)
-                    ide = np.where((xi > 0) & (de > 0), 1.0 / de, 0.0)
-                g = jac * np.exp(pr - 0.5 * (t + dl) ** 2)
-                acc[0] += g * P * xi ** 1.5
-                acc[1] += g * 1.5 * P * np.sqrt(xi) * ide
-                acc[2] += g * A * xi
-                acc[3] += g * A * ide
+                ide = 1.0 / de
+                xi = 1.0 - uta * ide                  # in (0, 1] inside the panel
+                np.maximum(xi, 0.0, out=xi)
+                ide = np.where(xi > 0, ide, 0.0)
+                sx = np.sqrt(xi)
+                tt = t + dl
+                g = jac * np.exp(pr - 0.5 * tt * tt)
+                gP = g * P
+                gA = g * A
+                acc[0] += gP * xi * sx
+                acc[1] += 1.5 * gP * sx * ide
+                acc[2] += gA * xi
+                acc[3] += gA * ide
         for o, a in zip(out, acc):
             o[live] += a
     return [o.reshape(shape) for o in out]
