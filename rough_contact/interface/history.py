@@ -50,6 +50,29 @@ from .normal import NormalLaw
 
 __all__ = ["HistoryNormalLawProtocol", "HistoryNormalLaw"]
 
+
+@runtime_checkable
+class HistoryNormalLawProtocol(Protocol):
+    """A normal law with one history variable per point, h_min (smallest separation so far).
+
+    ``rough_contact.interface.law.InterfaceLaw`` keeps h_min in its state when its normal law
+    implements this protocol (the irreversible knob); a plain ``NormalLawProtocol`` stays
+    reversible.
+    """
+
+    def evaluate_history(self, h: np.ndarray, h_min: np.ndarray, curvature: bool = False
+                         ) -> Tuple[np.ndarray, ...]:
+        """(p, k, a) or (p, k, a, dk/dh) at separations h (n,) [mm] after the smallest
+        separation h_min (n,) [mm]; where h <= h_min the loading branch (the caller commits
+        min(h, h_min)). k = -dp/dh at fixed h_min."""
+        ...
+
+    def normal_dissipation(self, h_min: np.ndarray) -> np.ndarray:
+        """D(h_min) (n,) [N/mm]: energy per nominal area dissipated by loading to h_min, so
+        that the work of any path is psi(h, h_min) + D(h_min); 0 where nothing yielded."""
+        ...
+
+
 # Uniform cubic B-spline blending in h_min: on row cell i, f(tm) = sum_a b_a(tm) c[i + a] with
 # b_a(tm) = sum_p _B[a, p] tm^p >= 0 and sum_a b_a = 1 (a convex combination of 4 control rows).
 _B = np.array([[1.0, -3.0, 3.0, -1.0], [4.0, 0.0, -6.0, 3.0], [1.0, 3.0, 3.0, -3.0],

@@ -186,12 +186,12 @@ def _coarse_table():
     strict=False): its mechanics do not depend on its accuracy."""
     from rough_contact.micro.asperity import AsperityMaterial
     mat = AsperityMaterial(E_star=1.14e5, psi=1.0).resolve(S1)
-    loading = NormalLaw.elasto_plastic(S1, mat, rtol=1e-2)
-    return HistoryNormalLaw.elasto_plastic(S1, mat, 1e-3, loading=loading, n_quad=8, n_t=16,
-                                           n_rows=2, n_x=4, max_points=40, strict=False)
+    loading = NormalLaw.elasto_plastic(S1, mat, rtol=1e-2, n_quad=8)
+    return HistoryNormalLaw.elasto_plastic(S1, mat, 1e-2, loading=loading, n_quad=8, n_t=16,
+                                           n_rows=3, n_x=2)
 
 
-@pytest.mark.slow    # ~10-25 s: a loading NormalLaw and a few dozen direct population sums
+@pytest.mark.slow    # ~5-15 s: a loading NormalLaw and a few hundred direct population sums
 def test_table_mechanics_continuity_tangent_energy():
     """The tabulated law: p and A/A0 continuous at the reversal (the branch starts at the
     loading law's value exactly), k the exact derivative of p on the unloading branch (FD),
@@ -219,7 +219,8 @@ def test_table_mechanics_continuity_tangent_energy():
     np.testing.assert_allclose(k, fd, rtol=1e-5)
     # dissipation at the table's rows (where D is computed; between rows it is interpolated):
     # D = W_load - E_rec, each integrated independently here
-    for hm in law._hm0 + law._dm * np.arange(2):
+    from rough_contact.interface.history import _row_h
+    for hm in _row_h(np.arange(2) / law._n_m, law._hm0, law._span, law._beta):
         hh = np.linspace(hm, law.h_max + 2 * sig, 200001)
         W = np.trapz(law.loading.evaluate(hh)[0], hh)
         E = np.trapz(law.evaluate_history(hh, np.full_like(hh, hm))[0], hh)
