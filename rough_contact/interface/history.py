@@ -90,7 +90,7 @@ def _row_h(v, h0, span, beta):
 
 def _row_v(h, h0, span, beta):
     """Inverse of ``_row_h`` on [h0, h0 + span] (h clipped to it)."""
-    s = np.clip((np.asarray(h, float) - h0) * (1.0 / span), 0.0, 1.0)
+    s = np.array(np.clip((np.asarray(h, float) - h0) * (1.0 / span), 0.0, 1.0), ndmin=1)
     if beta == 0.0:
         return s
     s *= 4.0 * beta * (1.0 + beta)
@@ -275,7 +275,8 @@ class HistoryNormalLaw:
 
     @classmethod
     def elasto_plastic(cls, surface, material, rtol: float = 1e-4, *, loading=None,
-                       n_quad: int = 16, n_t: int = 16, n_rows: int = 4, n_x: int = 8,
+                       n_quad: int = 16, n_t: int = 16, n_zeta: int = 24,
+                       n_rows: int = 4, n_x: int = 8,
                        tail: float = 1e-12, max_points: int = 20000,
                        max_seconds: float = 600.0, strict: bool = True) -> "HistoryNormalLaw":
         """Table of the elasto-plastic population with memory (reading "consistent").
@@ -288,7 +289,10 @@ class HistoryNormalLaw:
                 to the h_min direction (row midpoints at every other x knot).
             loading: a prebuilt ``NormalLaw.elasto_plastic`` of the same surface and material
                 (its build time is then not counted); None builds one at rtol.
-            n_quad, n_t: quadrature of the direct sums (shape rule, height nodes per panel).
+            n_quad, n_t, n_zeta: quadrature of the direct sums (K nodes per panel, height
+                nodes per half-panel, zeta nodes per half; ``micro.unloading._row_sums``). With
+                n_zeta = n_quad = 16 the sums are off by up to 9e-4 high above the mean plane
+                (h_min ~ 7 sigma, psi = 2); 24 zeta nodes bring them to <= 4e-6.
             n_rows: initial number of h_min intervals (>= 3; doubled as needed); these rows
                 also decide the graded x knots.
             n_x: initial number of uniform x intervals (>= 2; a failing interval is split).
@@ -304,7 +308,8 @@ class HistoryNormalLaw:
         t0 = time.perf_counter()
         rtol = check_scalar("rtol", rtol, lo=1e-8, hi=0.1, lo_open=False, hi_open=False)
         tail = check_scalar("tail", tail, lo=0.0, hi=1e-2)
-        for name, v, lo in (("n_rows", n_rows, 3), ("n_x", n_x, 2)):
+        for name, v, lo in (("n_rows", n_rows, 3), ("n_x", n_x, 2), ("n_quad", n_quad, 2),
+                            ("n_t", n_t, 2), ("n_zeta", n_zeta, 2)):
             if int(v) != v or v < lo:
                 raise ValueError(f"{name} = {v!r} is invalid: it must be an integer >= {lo}")
         mat = material.resolve(surface)
@@ -328,7 +333,7 @@ class HistoryNormalLaw:
                     if time.perf_counter() - t1 > max_seconds or n_pts[0] > max_points:
                         raise _Budget()
                     uu = np.concatenate([[0.0], np.asarray(need) * sig])
-                    p, k, a, da = U._row_sums(surface, mat, float(hm), uu, n_quad, n_t)
+                    p, k, a, da = U._row_sums(surface, mat, float(hm), uu, n_quad, n_t, n_zeta)
                     n_pts[0] += uu.size
                     p = np.maximum(p, 1e-300)
                     a = np.maximum(a, 1e-300)
@@ -414,6 +419,7 @@ class HistoryNormalLaw:
                          "x_knots": xk.size, "X": X, "model_points": n_pts[0],
                          "worst_error": float(worst), "worst_error_x": float(worst_x),
                          "worst_error_h_min": float(worst_m), "n_quad": n_quad, "n_t": n_t,
+                         "n_zeta": n_zeta,
                          "k_nonnegative": ok, "reversible": False,
                          "converged": bool(worst_x <= 0.5 * rtol and worst_m <= 0.5 * rtol)})
         return law

@@ -366,11 +366,14 @@ def _rule(n, a, b, mode):
     return a + (b - a) * s, (b - a) * ds * w
 
 
-def _row_sums(surface, mat, h_min, u, n_quad, n_t):
+def _row_sums(surface, mat, h_min, u, n_quad, n_t, n_zeta=None):
     """p, k, a, -da/dh at (h_min + u, h_min) for one h_min [mm] and an array u >= 0 [mm].
 
     Outer rule in (zeta, K) (``_Coords``): zeta on (0, 1/2) and (1/2, 1) (the circular ray
-    splits them; n_quad nodes each, clustered at the wedge edges); per zeta node, K on the
+    splits them; n_zeta nodes each (None: n_quad), clustered at the wedge edges: high above
+    the mean plane the zeta integrand peaks sharply near the edges, e.g. at zeta ~ 0.9 at
+    h_min = 7.35 sigma, where 16 nodes leave 3e-4 to 9e-4 (psi 1 to 2) and 24 nodes 1e-6 to
+    4e-6); per zeta node, K on the
     window where the unloading integrand itself lives (a scan of ``_SCAN`` points inside the
     loading window, keeping the integrand above exp(-_LOG_CUT) of its maximum on that line,
     widened by one scan cell: at large u only tall, flat summits still touch, far from where
@@ -381,8 +384,9 @@ def _row_sums(surface, mat, h_min, u, n_quad, n_t):
     l = h_min / C.smu
     tau = (np.asarray(u, float) / C.smu)[:, None]                 # (n_u, 1)
     n_u = tau.shape[0]
-    z, wz = zip(_rule(n_quad, np.zeros(1), np.full(1, 0.5), "lo"),
-                _rule(n_quad, np.full(1, 0.5), np.ones(1), "hi"))
+    nz = n_quad if n_zeta is None else n_zeta
+    z, wz = zip(_rule(nz, np.zeros(1), np.full(1, 0.5), "lo"),
+                _rule(nz, np.full(1, 0.5), np.ones(1), "hi"))
     zeta = np.concatenate(z)                                      # (2n,)
     wz = np.concatenate(wz)
     Ka, Kb = C.loading_window(l, zeta)
@@ -422,13 +426,14 @@ def _row_sums(surface, mat, h_min, u, n_quad, n_t):
 
 
 def population_unloading(surface, material: AsperityMaterial, h, h_min, n_quad: int = 16,
-                         n_t: int = 24):
+                         n_t: int = 24, n_zeta=None):
     """Population sums p [MPa], k = -dp/dh at fixed h_min [MPa/mm], A/A0 [-] at (h, h_min).
 
     The direct (untabulated) model of :class:`HistoryNormalLaw`. h_min scalar [mm]; h array
     [mm]; h < h_min is the loading branch (h_min := h there, k is then the unloading stiffness
     at h_min = h, not the loading one: the table takes the loading branch from ``NormalLaw``).
-    Reading: ``residual="consistent"``.
+    n_zeta: zeta nodes per half (None: n_quad; see ``_row_sums``). Reading:
+    ``residual="consistent"``.
     """
     mat = material.resolve(surface)
     h = np.atleast_1d(np.asarray(h, dtype=float))
@@ -441,11 +446,11 @@ def population_unloading(surface, material: AsperityMaterial, h, h_min, n_quad: 
         idx = np.flatnonzero(~lower)
         for c in range(0, idx.size, 64):
             sl = idx[c:c + 64]
-            vals = _row_sums(surface, mat, hm, u[sl], n_quad, n_t)[:3]
+            vals = _row_sums(surface, mat, hm, u[sl], n_quad, n_t, n_zeta)[:3]
             for r, v in zip(res, vals):
                 r[sl] = v
     for i in np.flatnonzero(lower):
-        vals = _row_sums(surface, mat, h[i], np.zeros(1), n_quad, n_t)[:3]
+        vals = _row_sums(surface, mat, h[i], np.zeros(1), n_quad, n_t, n_zeta)[:3]
         for r, v in zip(res, vals):
             r[i] = v[0]
     return tuple(r.reshape(np.shape(h)) for r in res)

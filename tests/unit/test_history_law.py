@@ -188,7 +188,7 @@ def _coarse_table():
     mat = AsperityMaterial(E_star=1.14e5, psi=1.0).resolve(S1)
     loading = NormalLaw.elasto_plastic(S1, mat, rtol=1e-2, n_quad=8)
     return HistoryNormalLaw.elasto_plastic(S1, mat, 1e-2, loading=loading, n_quad=8, n_t=16,
-                                           n_rows=3, n_x=2)
+                                           n_zeta=8, n_rows=3, n_x=2)
 
 
 @pytest.mark.slow    # ~5-15 s: a loading NormalLaw and a few hundred direct population sums

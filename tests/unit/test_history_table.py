@@ -162,7 +162,7 @@ def test_bad_build_arguments_are_named():
     s = SpectralMoments(m00=0.0625, m20=8e-5, m02=8e-4, m40=1.04e-6, m04=1.04e-4)
     mat = AsperityMaterial(E_star=1.14e5, psi=1.0)
     for kw, match in (({"n_rows": 2}, "n_rows = 2"), ({"n_x": 1}, "n_x = 1"),
-                      ({"rtol": 0.5}, "rtol")):
+                      ({"n_zeta": 1.5}, "n_zeta = 1.5"), ({"rtol": 0.5}, "rtol")):
         with pytest.raises(ValueError, match=match):
             HistoryNormalLaw.elasto_plastic(s, mat, **{"rtol": 1e-3, **kw})
 
@@ -179,7 +179,7 @@ def test_coarse_population_table_against_direct_sums_at_random_points():
     loading = NormalLaw.elasto_plastic(s, mat, rtol=1e-2, n_quad=8)
     rtol = 1e-2
     law = HistoryNormalLaw.elasto_plastic(s, mat, rtol, loading=loading, n_quad=8, n_t=16,
-                                          n_rows=3, n_x=2)
+                                          n_zeta=8, n_rows=3, n_x=2)
     info = law.info
     assert info["converged"] and info["worst_error"] <= rtol and info["k_nonnegative"]
     assert info["rows"] >= 4 and info["x_knots"] > 3
@@ -188,7 +188,7 @@ def test_coarse_population_table_against_direct_sums_at_random_points():
     errs = []
     for hm in rng.uniform(loading.h_min, loading.h_table_end, 6):
         x = rng.uniform(0.0, 4.0, 5)
-        p, k, a, _ = U._row_sums(s, mat, hm, np.concatenate([[0.0], x * sig]), 8, 16)
+        p, k, a, _ = U._row_sums(s, mat, hm, np.concatenate([[0.0], x * sig]), 8, 16, 8)
         pt, kt, at = law.evaluate_history(hm + x * sig, np.full(5, hm))
         use = p[1:] >= 1e-12 * p[0]
         e = np.max([np.abs(pt / p[1:] - 1), np.abs(kt / k[1:] - 1), np.abs(at / a[1:] - 1)],

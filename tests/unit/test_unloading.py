@@ -202,3 +202,26 @@ def test_population_unloading_stiffer_than_loading_and_fd_consistent():
     from rough_contact.micro import population as pop
     load = pop.elasto_plastic(S1, mat, h)
     assert np.all(p < load.pressure)
+
+
+@pytest.mark.parametrize("psi", [1.0, 2.0])
+def test_direct_sums_high_above_the_mean_plane_need_24_zeta_nodes(psi):
+    """High above the mean plane (h_min = 7.35 sigma, near the end of the table) only tall,
+    strongly anisotropic summits touch and the zeta integrand peaks sharply near the wedge
+    edge (zeta ~ 0.9): 16 zeta nodes per half leave 3e-4 (psi 1) to 9e-4 (psi 2) against
+    the loading population (population.elasto_plastic, the (p, q) rule: another code path)
+    at u = 0, and the unloading distances are as far off against a 40/32-node rule; 24 zeta
+    nodes (the history table's default) are within 1e-5 of both."""
+    from rough_contact.micro import population as pop
+    mat = AsperityMaterial(E_star=E_STAR, psi=psi).resolve(S1)
+    sig = S1.rq
+    hm = 7.35 * sig
+    u = np.array([0.0, 0.3, 1.0, 2.0]) * sig
+    load = pop.elasto_plastic(S1, mat, np.array([hm]), n_quad=40)
+    ref = np.array(U._row_sums(S1, mat, hm, u, 40, 32)[:3])
+    np.testing.assert_allclose(ref[0, 0], load.pressure[0], rtol=1e-7)
+    a = np.array(U._row_sums(S1, mat, hm, u, 16, 16, 24)[:3])
+    assert np.max(np.abs(a / ref - 1)) < 1e-5, a / ref - 1
+    assert abs(a[0, 0] / load.pressure[0] - 1) < 1e-5
+    old = np.array(U._row_sums(S1, mat, hm, u, 16, 16)[:3])      # n_zeta = n_quad = 16
+    assert np.max(np.abs(old / ref - 1)) > 1e-4
