@@ -23,18 +23,31 @@ D(h_min_old) >= 0, and over a closed cycle it equals the loop integral of p dh.
 
 Table (elasto-plastic). Loading branch: a ``NormalLaw.elasto_plastic``. Unloading branch:
 rho(h_min, x) = ln p(h, h_min) - ln p_load(h_min), x = (h - h_min)/sigma (sigma the rms height)
-on a uniform tensor grid in (h_min, x) over [h_lo, h_table_end] x [0, X], as a bicubic Hermite
-surface: x-slopes are the model's own stiffness (d rho/dx = -k sigma/p), h_min-slopes and the
-cross slopes are three-point differences. rho is smooth in both variables (nearly quadratic in
-x, slowly drifting with h_min), so the grid is coarse. The grid is refined by doubling, per
-direction, until the interpolant matches the direct population sums
-(``rough_contact.micro.unloading``) at the midpoints of both directions to rtol (p, k and A/A0,
-relative; check points where p < tail p_load(h_min) are not checked). k is the exact
-h-derivative of the interpolant (consistent tangent at fixed h_min); the build verifies k >= 0
-on a dense sample and records it in ``info``. Beyond x = X the branch tapers to zero as the
-``NormalLaw`` does (cubic, C1). h_min below the table: the branch shape of the first row,
-scaled by p_load(h_min); h_min >= h_table_end: nothing has yielded to within the table's tail:
-the loading law (reversible).
+and ln(a/a0) likewise, over [h_lo, h_table_end] x [0, X]:
+
+* x: cubic Hermite on graded knots, with the model's own slopes (d rho/dx = -k sigma/p); the
+  knots start uniform and every interval whose midpoint fails the check against the direct
+  sums (``rough_contact.micro.unloading``) on the first rows is split (rho bends sharply at
+  x ~ 0.3-0.5 on the high rows: the knots crowd there). O(1) look-up by a uniform table of
+  cells no wider than the shortest interval.
+* h_min: a uniform cubic B-spline in a row coordinate v, h_min = h_lo + span (v + beta v^2)/
+  (1 + beta) (beta = 1: rows 3x denser at h_lo, where rho varies fastest with h_min), through
+  rows uniform in v plus one ghost row beyond each end (not-a-knot conditions); the rows are
+  doubled until the row midpoints pass the check at every other x knot. Each half of rtol goes
+  to one direction. Values between rows are a convex combination (B-spline weights >= 0) of
+  four control rows, each a cubic Hermite curve in x.
+* monotone by construction: every control row's Hermite data is projected onto the set of
+  non-increasing curves (running minimum of the values, slopes clipped to <= 0 and scaled into
+  the Fritsch-Carlson circle), so rho, and with it p, is non-increasing in h at every h_min:
+  k >= 0 everywhere (the build also samples it, ``info["k_nonnegative"]``;
+  ``info["monotone_projection_changes"]`` counts the data the projection changed).
+* k is the exact h-derivative of the interpolant (consistent tangent at fixed h_min); the
+  cells are stored as polynomial coefficients in (t_v, t_x), gathered per point with one take.
+  Check points where p < tail p_load(h_min) are not checked. Beyond x = X the branch tapers to
+  zero as the ``NormalLaw`` does (cubic, C1).
+* h_min below the table: the branch shape of the first row, scaled by p_load(h_min);
+  h_min >= h_table_end: nothing has yielded to within the table's tail: the loading law
+  (reversible).
 """
 from __future__ import annotations
 
@@ -557,7 +570,10 @@ class HistoryNormalLaw:
         if x.max() > self._X:
             tp = np.flatnonzero(x > self._X)
             pe, ke, ae = p[tp], k[tp], a[tp]
-            L = 3.0 * pe / np.maximum(ke, 1e-300)
+            # taper length 3 p/k at X (C1); sigma where k(X) = 0 (a flat tail: p(X), far
+            # below the tail ratio, may have underflowed to 0)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                L = np.where(ke > 0.0, 3.0 * pe / ke, sig)
             t = np.clip((x[tp] - self._X) * sig / L, 0.0, 1.0)
             p[tp] = pe * (1 - t) ** 3
             k[tp] = 3.0 * pe / L * (1 - t) ** 2

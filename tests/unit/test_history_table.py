@@ -195,3 +195,17 @@ def test_coarse_population_table_against_direct_sums_at_random_points():
                    axis=0)
         errs.extend(e[use])
     assert len(errs) > 20 and max(errs) <= rtol
+
+
+def test_taper_beyond_the_table_is_finite_when_p_underflows_at_its_end():
+    """Far beyond the tail p(X) underflows to 0 on steep rows (the population's high rows
+    reach rho ~ -2000 at X): the taper past X must give zeros, not 0/0 (it gave NaN k)."""
+    steep = lambda v, x: -(1.0 + v) * x - 60.0 * x * x                  # noqa: E731
+    dsteep = lambda v, x: -(1.0 + v) - 120.0 * x                         # noqa: E731
+    law = _synthetic(steep, dsteep, _la, _dla)
+    hm = np.linspace(law.h_min, law.h_table_end, 40)[:-1]
+    for x in (XK[-1] - 1e-9, XK[-1] + 0.5, XK[-1] + 3.0):
+        p, k, a, dk = law.evaluate_history(hm + x * SIG, hm, curvature=True)
+        for v in (p, k, a, dk):
+            assert np.all(np.isfinite(v))
+        assert np.all(p >= 0) and np.all(k >= 0) and np.all(p < 1e-300)
