@@ -15,6 +15,7 @@ are exercised by the coarse real table at the end. Units: mm, MPa.
 from __future__ import annotations
 
 import numpy as np
+from scipy.integrate import trapezoid
 import pytest
 
 from rough_contact.interface import history as H
@@ -149,8 +150,8 @@ def test_dissipation_is_loading_work_minus_recoverable_energy():
     rows = H._row_h(np.arange(n_m + 1) / n_m, law._hm0, law._span, law._beta)
     for hm in rows[:-1:2]:
         hh = np.linspace(hm, law.h_max + 2 * SIG, 400001)
-        W = np.trapz(law.loading.evaluate(hh)[0], hh)
-        E = np.trapz(law.evaluate_history(hh, np.full_like(hh, hm))[0], hh)
+        W = trapezoid(law.loading.evaluate(hh)[0], hh)
+        E = trapezoid(law.evaluate_history(hh, np.full_like(hh, hm))[0], hh)
         assert float(law.normal_dissipation(np.array([hm]))[0]) == pytest.approx(W - E, rel=1e-5)
     D = law.normal_dissipation(np.linspace(law.h_min - 2 * SIG, law.h_max, 500))
     assert np.all(D >= 0) and np.all(np.diff(D) <= 1e-12 * D.max())
