@@ -17,22 +17,25 @@ def write_csv(path, rows) -> None:
         w.writerows(rows)
 
 
-MEMORY_MATERIALS = ("paper", "psi")
+MEMORY_MATERIALS = ("paper", "psi", "psi=<value>")
 
 
 def punch_material(material="paper"):
     """Asperity data of the punch's surface: ``"paper"`` the data of Figs 18-19
     (``flat_punch.PLASTIC``: Y = 2070 MPa, K_Y = 1.62, psi = 0.35); ``"psi"`` the same plasticity
     index psi = 0.35 (so the same hardness H) with the paper's default yield convention
-    K_Y Y = (2/pi) H (Y not given)."""
+    K_Y Y = (2/pi) H (Y not given); ``"psi=<value>"`` that convention at another plasticity
+    index (H from psi and the surface)."""
     from rough_contact.micro.asperity import AsperityMaterial
     from rough_contact.scenes import flat_punch as P
 
     E_star = P.effective_modulus(P.E, P.NU, P.E, P.NU)
     if material == "paper":
         return AsperityMaterial(E_star=E_star, nu=P.NU, **P.PLASTIC)
-    if material == "psi":
+    if material == "psi" or material.startswith("psi="):
         data = {k: v for k, v in P.PLASTIC.items() if k not in ("Y", "K_Y")}
+        if material != "psi":
+            data["psi"] = float(material[4:])
         return AsperityMaterial(E_star=E_star, nu=P.NU, **data)
     raise ValueError(f"material = {material!r} is invalid: valid values {MEMORY_MATERIALS}")
 

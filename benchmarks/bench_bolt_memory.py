@@ -114,7 +114,8 @@ def main(argv=None):
     ap.add_argument("--amplitude", type=float, default=1.0, help="u_x amplitude [um]")
     ap.add_argument("--size-cylinder", type=float, default=1.0)
     ap.add_argument("--size-block", type=float, default=1.6)
-    ap.add_argument("--material", default="psi", choices=MEMORY_MATERIALS)
+    ap.add_argument("--material", default="psi", help=f"asperity data: {MEMORY_MATERIALS} "
+                    "(benchmarks/_common.py punch_material)")
     ap.add_argument("--rtol", type=float, default=1e-3)
     ap.add_argument("--out", default="results/bench_bolt_memory")
     ap.add_argument("--cache", default="results/bench_punch_memory",

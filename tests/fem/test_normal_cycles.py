@@ -84,3 +84,12 @@ def test_normal_hysteresis_shakes_down_after_the_first_cycle():
                                atol=1e-10 * max(np.abs(r1.normal_dissipation).max(), 1e-300))
     np.testing.assert_allclose(dn, [c["normal_dissipated"] for c in r1.cycles], rtol=1e-10,
                                atol=1e-10 * dn[0])
+
+
+def test_bolt_cycles_bad_mode():
+    from rough_contact.scenes import bolt_head
+    with pytest.raises(ValueError, match="mode = 'axial' is invalid: it must be 'normal' or "
+                       "'tangential'"):
+        bolt_head.run_cycles("axial")
+    with pytest.raises(ValueError, match="amplitude"):
+        bolt_head.run_cycles("tangential", amplitude_um=-1.0)
