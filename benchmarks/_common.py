@@ -15,3 +15,67 @@ def write_csv(path, rows) -> None:
         w = csv.DictWriter(f, fieldnames=list(rows[0]))
         w.writeheader()
         w.writerows(rows)
+
+
+MEMORY_MATERIALS = ("paper", "psi", "psi=<value>")
+
+
+def punch_material(material="paper"):
+    """Asperity data of the punch's surface: ``"paper"`` the data of Figs 18-19
+    (``flat_punch.PLASTIC``: Y = 2070 MPa, K_Y = 1.62, psi = 0.35); ``"psi"`` the same plasticity
+    index psi = 0.35 (so the same hardness H) with the paper's default yield convention
+    K_Y Y = (2/pi) H (Y not given); ``"psi=<value>"`` that convention at another plasticity
+    index (H from psi and the surface)."""
+    from rough_contact.micro.asperity import AsperityMaterial
+    from rough_contact.scenes import flat_punch as P
+
+    E_star = P.effective_modulus(P.E, P.NU, P.E, P.NU)
+    if material == "paper":
+        return AsperityMaterial(E_star=E_star, nu=P.NU, **P.PLASTIC)
+    if material == "psi" or material.startswith("psi="):
+        data = {k: v for k, v in P.PLASTIC.items() if k not in ("Y", "K_Y")}
+        if material != "psi":
+            data["psi"] = float(material[4:])
+        return AsperityMaterial(E_star=E_star, nu=P.NU, **data)
+    raise ValueError(f"material = {material!r} is invalid: valid values {MEMORY_MATERIALS}")
+
+
+def punch_memory_law(cache_dir, rtol=1e-3, comm=None, material="paper"):
+    """The flat punch's elasto-plastic population with memory (``HistoryNormalLaw.elasto_plastic``
+    of the paper's section 9.2 surface and the asperity data ``material`` of
+    :func:`punch_material`, strict=False), built once and cached as a pickle in ``cache_dir``
+    (keyed by rtol, the surface moments and the asperity data; a cache of other data is
+    rebuilt). Built on rank 0 and sent to the others (collective when ``comm`` is given).
+    Returns ``(law, seconds, cached)``: the build's wall time (that of the cached build when
+    read back) and whether it was read."""
+    import pickle
+    import time
+
+    from rough_contact.scenes import flat_punch as P
+
+    mat = punch_material(material)
+    key = dict(rtol=rtol, moments=P.MOMENTS_UM, material=repr(mat), E=P.E, nu=P.NU)
+    path = os.path.join(cache_dir, f"memory_law_{material}_rtol{rtol:g}.pkl")
+    out = None
+    if comm is None or comm.rank == 0:
+        if os.path.exists(path):
+            with open(path, "rb") as f:
+                saved = pickle.load(f)
+            if saved.get("key") == key:
+                out = (saved["law"], saved["seconds"], True)
+        if out is None:
+            from rough_contact.interface.history import HistoryNormalLaw
+            from rough_contact.surface import SpectralMoments
+
+            surface = SpectralMoments(**P.MOMENTS_UM, unit="um")
+            t0 = time.perf_counter()
+            law = HistoryNormalLaw.elasto_plastic(surface, mat, rtol=rtol, strict=False)
+            seconds = time.perf_counter() - t0
+            os.makedirs(cache_dir, exist_ok=True)
+            with open(path + ".tmp", "wb") as f:
+                pickle.dump(dict(key=key, law=law, seconds=seconds), f)
+            os.replace(path + ".tmp", path)
+            out = (law, seconds, False)
+    if comm is not None:
+        out = comm.bcast(out, root=0)
+    return out

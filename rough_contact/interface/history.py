@@ -248,6 +248,16 @@ class HistoryNormalLaw:
     _IL: float = 0.0                    # int exp(rho(row 0, x)) dx incl. taper [-]
     info: dict = field(default_factory=dict, compare=False)   # build statistics, not identity
 
+    def __setstate__(self, state):
+        """Unpickle; a table pickled by the session-3 code (uniform bicubic grid, keys _C, _dm)
+        is refused: its cells would be read as a reversible law."""
+        if "_C" in state or "_dm" in state:
+            raise ValueError("HistoryNormalLaw: this pickle holds a table in the older format "
+                             "(uniform bicubic grid, before the graded B-spline table): it "
+                             "cannot be read; delete the cached file and rebuild the law")
+        for key, value in state.items():
+            object.__setattr__(self, key, value)
+
     # ------------------------------------------------------------ NormalLaw interface
     @property
     def reversible(self) -> bool:

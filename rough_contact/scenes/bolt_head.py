@@ -14,6 +14,12 @@ in ``shear_steps`` increments; u_y, u_z free). The cylinder is held only by the 
 Checked at every converged increment: the interface force on the cylinder balances the
 preload in z and the reaction of the prescribed top displacement in x, to 1e-8 of P.
 
+Cycles (:func:`run_cycles`, issue 23: a normal law that remembers asperity plasticity):
+``mode="normal"`` cycles the normal load between ``low`` P and P (force control, the top's u_x
+held at 0); ``mode="tangential"`` holds the bolt's stretch (the top's u_z prescribed: the value
+that carries P under force control, found by a force-controlled preload first) and cycles
+u_x = a w(t) (triangle wave); the clamping force is then whatever the interface carries.
+
 Units: mm, N, MPa (the slide given in um at the API).
 """
 
@@ -25,18 +31,20 @@ import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
 
+from rough_contact.fem.boundary import SurfaceMean
 from rough_contact.fem.compat import vector_space
-from rough_contact.fem.problem import Material
+from rough_contact.fem.problem import ContactProblem, Material, PrescribedDisplacement
 from rough_contact.scenes import flat_punch
-from rough_contact.scenes.defaults import GRAIN_X, quadrature_degree
+from rough_contact.scenes.defaults import GRAIN_X, SEATING_STIFFNESS, quadrature_degree
 from rough_contact.scenes.setup import clamped_pair, preload_then_drive
 from rough_contact.scenes.meshes.blocks import cylinder_on_block
 from rough_contact.solver.loading import load_path
-from rough_contact.solver.program import LoadProgram
+from rough_contact.solver.program import (LoadProgram, cycle_boundaries, cycle_summary,
+                                         preload_then_cyclic, preload_then_normal_cycles)
 from rough_contact.solver.snes import SNESSolver
 from rough_contact.validation import check_scalar
 
-__all__ = ["BoltIncrement", "BoltHeadRun", "program", "run"]
+__all__ = ["BoltIncrement", "BoltHeadRun", "program", "run", "BoltCyclesRun", "run_cycles"]
 
 
 @dataclass(frozen=True)
@@ -154,3 +162,154 @@ def run(pressure=10.0, slide_um=2.0, radius=5.0, height=5.0, size_cylinder=1.0,
     solver.destroy()
     return BoltHeadRun(P=P, dofs=problem.num_dofs, points=interface.summary().n_points,
                        pairing=interface.pairing_used, rows=rows)
+
+
+@dataclass(frozen=True)
+class BoltCyclesRun:
+    """Result of :func:`run_cycles` (identical on every rank). Arrays: one entry per increment.
+
+    Attributes:
+        mode: "normal" (normal load cycles) or "tangential" (u_x cycles at a fixed stretch).
+        P: preload [N] (the peak of the normal cycles; the force-controlled preload that fixed
+            the stretch in tangential mode).
+        stretch: the top's prescribed downward u_z in tangential mode [mm] (NaN in normal mode).
+        dofs: global number of DOFs.
+        t: pseudo-times.
+        u_x: the top's u_x [mm].
+        approach: -mean u_z of the cylinder's top [mm].
+        load: applied normal force (normal mode; the reaction in tangential mode) [N].
+        F_z: normal force of the block on the cylinder (up) [N] (the clamping force).
+        F_x: friction force resisting the slide, -F_x of the interface on the cylinder [N].
+        dissipation: cumulative frictional dissipation [N mm].
+        normal_dissipation: cumulative normal hysteresis [N mm] (0 for a reversible law).
+        slip_fraction: slipping area / area in contact [-].
+        contact_fraction: area in contact / nominal area [-].
+        boundaries, cycles: the complete cycles (``cycle_summary`` of (approach, load) in
+            normal mode, of (u_x, reaction F_x of the top) in tangential mode; with
+            ``normal_dissipated``).
+        normal: the normal law used.
+        wall_time: seconds.
+    """
+
+    mode: str
+    P: float
+    stretch: float
+    dofs: int
+    t: np.ndarray
+    u_x: np.ndarray
+    approach: np.ndarray
+    load: np.ndarray
+    F_z: np.ndarray
+    F_x: np.ndarray
+    dissipation: np.ndarray
+    normal_dissipation: np.ndarray
+    slip_fraction: np.ndarray
+    contact_fraction: np.ndarray
+    boundaries: np.ndarray
+    cycles: list
+    normal: object
+    wall_time: float
+
+    def table(self) -> str:
+        """One line per cycle: normal hysteresis, frictional dissipation, the clamping force
+        and the slipping share at the cycle's end."""
+        lines = [f"  {'cycle':>5} {'D_normal [N mm]':>16} {'D_friction [N mm]':>18} "
+                 f"{'F_z end [N]':>12} {'slip % max':>10}"]
+        for c in self.cycles:
+            span = slice(c["start"] + 1, c["end"] + 1)
+            lines.append(f"  {c['cycle']:5d} {c['normal_dissipated']:16.6e} "
+                         f"{c['dissipated']:18.6e} {self.F_z[c['end']]:12.6f} "
+                         f"{100 * self.slip_fraction[span].max():10.2f}")
+        return "\n".join(lines)
+
+
+def run_cycles(mode="normal", *, pressure=10.0, low=0.1, amplitude_um=1.0, cycles=5,
+               steps_per_cycle=8, preload_steps=2, radius=5.0, height=5.0, size_cylinder=1.0,
+               size_block=1.6, order=1, pairing="mortar", case="b", normal_law="elastic",
+               normal=None, comm=MPI.COMM_WORLD, progress=True,
+               prefix="boltc_") -> BoltCyclesRun:
+    """Normal or tangential load cycles of the bolt head (module doc). Collective.
+
+    ``mode="normal"``: the preload ramps to ``low`` P (``preload_steps``), then ``cycles``
+    cycles low P -> P -> low P (``preload_then_normal_cycles``), u_x of the top held at 0.
+    ``mode="tangential"``: a force-controlled preload to P finds the stretch (the top's mean
+    u_z); then a second run prescribes that u_z uniformly on the top (ramped in
+    ``preload_steps``) and cycles u_x between +-``amplitude_um`` (``preload_then_cyclic``,
+    triangle). ``normal_law`` / ``normal``: as ``flat_punch.make_law`` (e.g. a prebuilt
+    ``HistoryNormalLaw``); ``case``: friction case or "none".
+    """
+    t0 = MPI.Wtime()
+    if mode not in ("normal", "tangential"):
+        raise ValueError(f"mode = {mode!r} is invalid: it must be 'normal' or 'tangential'")
+    check_scalar("pressure", pressure, lo=0.0, unit="MPa")
+    a = check_scalar("amplitude", amplitude_um, lo=0.0, unit="um") * 1e-3
+    scene = cylinder_on_block(radius=radius, height=height, size_cylinder=size_cylinder,
+                              size_block=size_block, order=order, comm=comm)
+    P = pressure * np.pi * radius**2
+    seat = pressure * (low if mode == "normal" else 1.0) / preload_steps
+    law, normal = flat_punch.make_law(comm, case=case, normal_law=normal_law,
+                                      seating_pressure=seat, normal=normal)
+    top = scene.tag("cylinder_top")
+    material = Material(flat_punch.E, flat_punch.NU)
+
+    def interface_and_clamp(V):
+        return clamped_pair(scene, V, law, grain_direction=GRAIN_X,
+                            quadrature_degree=quadrature_degree(order), pairing=pairing)
+
+    stretch = float("nan")
+    if mode == "normal":
+        prog = preload_then_normal_cycles(preload_steps, cycles, steps_per_cycle, low)
+        V = vector_space(scene.mesh, order)
+        clamp, ci = interface_and_clamp(V)
+        problem = preload_then_drive(scene, V, material, clamp, ci, top, P, 0.0, "cyclic",
+                                     prog.channels)
+    else:
+        # the stretch that carries P: a force-controlled preload (same law, a problem of its own)
+        V = vector_space(scene.mesh, order)
+        clamp, ci = interface_and_clamp(V)
+        pre = program(preload_steps, 1)
+        problem = preload_then_drive(scene, V, material, clamp, ci, top, P, 0.0, "shear",
+                                     pre.channels)
+        solver = SNESSolver(problem, prefix=prefix + "pre_")
+        for _ in load_path(problem, solver, pre.times[:preload_steps], verbose=False):
+            pass
+        stretch = -SurfaceMean(problem.u, scene.facet_tags, top, 2)()
+        solver.destroy()
+        prog = preload_then_cyclic(preload_steps, cycles, steps_per_cycle, shape="triangle")
+        V = vector_space(scene.mesh, order)
+        clamp, ci = interface_and_clamp(V)
+        problem = ContactProblem(
+            V, material, [clamp], [], facet_tags=scene.facet_tags, interface=ci,
+            seating_tag=ci.first_tag, seating_stiffness=SEATING_STIFFNESS,
+            prescribed=[PrescribedDisplacement(top, (0.0, 0.0, -stretch), (2,), "preload"),
+                        PrescribedDisplacement(top, (a, 0.0, 0.0), (0,), "cyclic")],
+            programs=prog.channels)
+    solver = SNESSolver(problem, prefix=prefix)
+    top_uz = SurfaceMean(problem.u, scene.facet_tags, top, 2)
+    rows = []
+    for inc in load_path(problem, solver, prog.times, verbose=False):
+        F = inc.contact_force                                 # on the cylinder
+        R = problem.reaction(top)
+        s = ci.summary()
+        load = P * problem.scales["preload"] if mode == "normal" else -R[2]
+        rows.append((inc.load_factor, problem.scales["cyclic"] * a, -top_uz(), load, F[2],
+                     -F[0], R[0], inc.dissipation, inc.normal_dissipation,
+                     s.slipping_area / s.contact_area if s.contact_area > 0 else 0.0,
+                     s.contact_area / s.nominal_area))
+        k = inc.load_factor - prog.cycle_start
+        if progress and k > 0.5 and abs(k - round(k)) < 1e-9:
+            PETSc.Sys.Print(f"  {mode} cycle {int(round(k))}/{cycles}: F_z = {F[2]:.6g} N, "
+                            f"normal hysteresis {inc.normal_dissipation:.6e} N mm, friction "
+                            f"{inc.dissipation:.6e} N mm (cumulative)  "
+                            f"[{MPI.Wtime() - t0:.1f} s]", comm=comm)
+    solver.destroy()
+    t, ux, w, load, fz, fx, rx, d, dn, slip, contact = np.array(rows).T
+    if mode == "normal":
+        summary = cycle_summary(t, prog, w, load, d, normal_dissipation=dn)
+    else:
+        summary = cycle_summary(t, prog, ux, rx, d, normal_dissipation=dn)
+    return BoltCyclesRun(mode=mode, P=P, stretch=stretch, dofs=problem.num_dofs, t=t, u_x=ux,
+                         approach=w, load=load, F_z=fz, F_x=fx, dissipation=d,
+                         normal_dissipation=dn, slip_fraction=slip, contact_fraction=contact,
+                         boundaries=cycle_boundaries(t, prog), cycles=summary, normal=normal,
+                         wall_time=MPI.Wtime() - t0)

@@ -41,6 +41,7 @@ import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
 
+from rough_contact.fem.boundary import SurfaceMean
 from rough_contact.fem.compat import vector_space
 from rough_contact.fem.problem import Material
 from rough_contact.io import CsvRecorder
@@ -52,12 +53,13 @@ from rough_contact.scenes.setup import clamped_pair, preload_then_drive
 from rough_contact.scenes.meshes.blocks import two_blocks
 from rough_contact.solver.checkpoint import has_checkpoint
 from rough_contact.solver.loading import load_path
-from rough_contact.solver.program import cycle_boundaries, cycle_summary, preload_then_cyclic
+from rough_contact.solver.program import (cycle_boundaries, cycle_summary, preload_then_cyclic,
+                                         preload_then_normal_cycles)
 from rough_contact.solver.snes import SNESSolver
 from rough_contact.validation import check_scalar
 
 __all__ = ["FrettingRun", "CycleReport", "PreloadStiffness", "run_amplitude", "run",
-           "REPORT_COLUMNS"]
+           "REPORT_COLUMNS", "NormalCyclesRun", "run_normal_cycles", "NORMAL_COLUMNS"]
 
 
 _SCENES: dict = {}   # meshes built by run_amplitude, per parameters and communicator
@@ -305,6 +307,140 @@ def run_amplitude(amplitude_um: float, *, size=2.0, height=1.0, mesh_size=0.5, o
                        k_normal=float(k_interface.value[0]),
                        k_tangential=float(k_interface.value[1]),
                        steps_per_cycle=int(steps_per_cycle), wall_time=MPI.Wtime() - t0)
+
+
+NORMAL_COLUMNS = ("pseudo_time", "load_share", "F_z_applied_N", "approach_mm", "mean_gap_mm",
+                  "F_z_contact_N", "F_x_N", "dissipation_Nmm", "normal_dissipation_Nmm",
+                  "slip_area_fraction", "contact_area_fraction", "newton_its_spent")
+"""Columns of :func:`run_normal_cycles`'s per-increment CSV."""
+
+
+@dataclass(frozen=True)
+class NormalCyclesRun:
+    """Result of :func:`run_normal_cycles` (identical on every rank). Arrays: one entry per
+    increment.
+
+    Attributes:
+        force: peak normal force P [N] (the load cycles between ``low`` P and P).
+        low: the minimum of the cycles as a share of P [-].
+        dofs: global number of DOFs.
+        t: pseudo-time of each increment (``preload_then_normal_cycles``).
+        load: applied normal force (pressing, > 0) [N].
+        approach: mean downward displacement of the loaded top face, -mean u_z [mm] (the
+            work-conjugate of the uniform normal load: its work is int load d(approach)).
+        gap: mean interface gap, int g dA / A_nominal [mm] (h = h0 + g).
+        fz: normal interface force on the upper block (up) [N].
+        fx: reaction F_x of the top (its u_x is held) [N].
+        dissipation: cumulative frictional dissipation [N mm].
+        normal_dissipation: cumulative normal hysteresis of a law with memory [N mm] (0 for
+            a reversible law).
+        slip_fraction: slipping area / nominal area [-].
+        contact_fraction: area in contact / nominal area [-].
+        boundaries: the complete cycles among the increments (``cycle_boundaries``).
+        cycles: per cycle (``cycle_summary`` of approach and load): ``loop_energy`` (the work
+            of the normal load over the cycle, trapezoidal [N mm]), ``dissipated`` (frictional),
+            ``normal_dissipated`` (normal hysteresis), amplitudes, start, end.
+        normal: the normal law used (to reuse).
+        newton: Newton iterations spent.
+        wall_time: seconds spent in this call.
+    """
+
+    force: float
+    low: float
+    dofs: int
+    t: np.ndarray
+    load: np.ndarray
+    approach: np.ndarray
+    gap: np.ndarray
+    fz: np.ndarray
+    fx: np.ndarray
+    dissipation: np.ndarray
+    normal_dissipation: np.ndarray
+    slip_fraction: np.ndarray
+    contact_fraction: np.ndarray
+    boundaries: np.ndarray
+    cycles: list
+    normal: object
+    newton: int
+    wall_time: float
+
+    def table(self) -> str:
+        """One line per cycle: normal hysteresis, frictional dissipation, load work, the
+        mean gap at the cycle's end."""
+        lines = [f"  {'cycle':>5} {'D_normal [N mm]':>16} {'D_friction [N mm]':>18} "
+                 f"{'load work [N mm]':>17} {'gap at end [um]':>16} {'slip [%] max':>12}"]
+        for c in self.cycles:
+            span = slice(c["start"] + 1, c["end"] + 1)
+            lines.append(f"  {c['cycle']:5d} {c['normal_dissipated']:16.6e} "
+                         f"{c['dissipated']:18.6e} {c['loop_energy']:17.6e} "
+                         f"{1e3 * self.gap[c['end']]:16.6f} "
+                         f"{100 * self.slip_fraction[span].max():12.2f}")
+        return "\n".join(lines)
+
+
+def run_normal_cycles(*, pressure=10.0, low=0.1, cycles=5, steps_per_cycle=8, shape="triangle",
+                      preload_steps=1, size=2.0, height=1.0, mesh_size=0.5, order=1,
+                      case="b", normal_law="elastic", normal=None, comm=MPI.COMM_WORLD,
+                      verbose=False, progress=True, csv_path=None,
+                      prefix="fretn_") -> NormalCyclesRun:
+    """Normal load cycles of the fretting joint: the top's u_x held at 0, its normal load
+    ramped to ``low`` x P (P = ``pressure`` x the nominal area), then ``cycles`` cycles
+    low P -> P -> low P (``rough_contact.solver.program.preload_then_normal_cycles``).
+    Collective; returns identical results on every rank.
+
+    With a normal law with memory (``normal_law`` "elasto-plastic-memory", or a prebuilt
+    ``normal`` implementing ``HistoryNormalLawProtocol``) the first cycle, which carries the
+    first loading to P, dissipates normal hysteresis; later cycles at the same amplitude
+    reload along the unloading branch of the same h_min and dissipate none (shakedown of the
+    normal hysteresis); the friction may go on dissipating (the Poisson expansion of the
+    blocks makes the interface's edges slip). ``case``: the friction case of the punch
+    (``flat_punch.FRICTION_CASES``) or "none". ``csv_path``: one row per increment
+    (``NORMAL_COLUMNS``).
+    """
+    t0 = MPI.Wtime()
+    check_scalar("pressure", pressure, lo=0.0, unit="MPa")
+    prog = preload_then_normal_cycles(preload_steps, cycles, steps_per_cycle, low, shape)
+    key = (size, height, mesh_size, order, comm.py2f())
+    if key not in _SCENES:
+        _SCENES[key] = two_blocks(lx=size, ly=size, h1=height, h2=height,
+                                  mesh_size=mesh_size, order=order, comm=comm)
+    scene = _SCENES[key]
+    V = vector_space(scene.mesh, order)
+    force = pressure * size * size
+    law, normal = flat_punch.make_law(comm, case=case, normal_law=normal_law,
+                                      seating_pressure=pressure * low / preload_steps,
+                                      normal=normal)
+    clamp, ci = clamped_pair(scene, V, law, quadrature_degree=quadrature_degree(order))
+    top = scene.tag("top")
+    problem = preload_then_drive(scene, V, Material(flat_punch.E, flat_punch.NU), clamp, ci, top,
+                                 force, 0.0, "cyclic", prog.channels)
+    solver = SNESSolver(problem, prefix=prefix)
+    top_uz = SurfaceMean(problem.u, scene.facet_tags, top, 2)
+    rec = CsvRecorder(csv_path, NORMAL_COLUMNS, comm)
+    area = ci.nominal_area()
+    for inc in load_path(problem, solver, prog.times, verbose=verbose, outputs=[rec]):
+        s = ci.summary()
+        pf = ci.point_fields()
+        gap = comm.allreduce(float(np.dot(ci.point_weights(), pf.gap)), op=MPI.SUM) / area
+        share = problem.scales["preload"]
+        rec.add((inc.load_factor, share, force * share, -top_uz(), gap, inc.contact_force[2],
+                 problem.reaction(top)[0], inc.dissipation, inc.normal_dissipation,
+                 s.slipping_area / s.nominal_area, s.contact_area / s.nominal_area,
+                 inc.newton_total))
+        k = inc.load_factor - prog.cycle_start
+        if progress and k > 0.5 and abs(k - round(k)) < 1e-9:
+            PETSc.Sys.Print(f"  normal cycle {int(round(k))}/{cycles}: normal hysteresis "
+                            f"{inc.normal_dissipation:.6e} N mm, friction "
+                            f"{inc.dissipation:.6e} N mm (cumulative)  "
+                            f"[{MPI.Wtime() - t0:.1f} s]", comm=comm)
+    solver.destroy()
+    t, share, load, w, gap, fz, fx, d, dn, slip, contact, its = rec.array().T
+    return NormalCyclesRun(force=force, low=float(low), dofs=problem.num_dofs, t=t, load=load,
+                           approach=w, gap=gap, fz=fz, fx=fx, dissipation=d,
+                           normal_dissipation=dn, slip_fraction=slip, contact_fraction=contact,
+                           boundaries=cycle_boundaries(t, prog),
+                           cycles=cycle_summary(t, prog, w, load, d, normal_dissipation=dn),
+                           normal=normal, newton=int(its.sum()), wall_time=MPI.Wtime() - t0)
 
 
 def report_table(reports) -> str:

@@ -15,6 +15,11 @@ Programs built here (t is dimensionless; the nominal loads are those of the chan
   is 0 during the preload, then ``amplitude x w(t - 1)`` with w a sine (sin 2 pi s) or a
   triangle wave (0 -> 1 -> -1 -> 0 per unit s) for ``cycles`` cycles of unit length, with
   ``steps_per_cycle`` increments each (a multiple of 4, so the extremes are increments).
+* :func:`preload_then_normal_cycles`: ``preload`` ramps 0 -> ``low`` over t in [0, 1], then
+  cycles between ``low`` and 1 (up, then down: low -> 1 -> low per unit of t, triangle or
+  cosine), ``cycles`` times; a second channel ``cyclic`` (a tangential drive) may cycle with
+  it, 0 by default: normal load cycles of a joint (the first cycle carries the first loading
+  to the peak, so a law with memory dissipates in it and, at a fixed amplitude, not after).
 
 Units: none (scales multiply the channels' nominal values).
 """
@@ -31,7 +36,7 @@ from rough_contact.cycles import energy_ratio, loop_amplitudes, loop_energies
 from rough_contact.validation import check_scalar
 
 __all__ = ["LoadProgram", "proportional", "preload_then_hold", "preload_then_cyclic",
-           "cycle_index", "cycle_boundaries", "cycle_summary"]
+           "preload_then_normal_cycles", "cycle_index", "cycle_boundaries", "cycle_summary"]
 
 
 @dataclass(frozen=True)
@@ -114,6 +119,54 @@ def preload_then_cyclic(preload_steps: int, cycles: int, steps_per_cycle: int,
     return LoadProgram({preload: _ramp_hold, cyclic: wave}, times, cycle_start=1.0)
 
 
+def preload_then_normal_cycles(preload_steps: int, cycles: int, steps_per_cycle: int,
+                               low: float = 0.1, shape: str = "triangle",
+                               preload: str = "preload", cyclic: str = "cyclic",
+                               tangential: float = 0.0) -> LoadProgram:
+    """Normal load cycles: ``preload`` ramps 0 -> ``low`` over t in (0, 1], then goes up to 1
+    and back to ``low`` in each cycle (unit pseudo-time; the peak at mid-cycle).
+
+    Args:
+        preload_steps: increments of the ramp to ``low`` (t in (0, 1]), >= 1.
+        cycles: number of cycles, >= 1.
+        steps_per_cycle: increments per cycle, an even number >= 2 (the peak is an increment).
+        low: the normal load's minimum as a share of its peak, in (0, 1) (> 0: a rough joint
+            held only by its interface needs some load to stay seated).
+        shape: ``"triangle"`` (linear up and down) or ``"cosine"`` (low + (1 - low)
+            (1 - cos 2 pi s)/2).
+        preload, cyclic: channel names.
+        tangential: amplitude of the ``cyclic`` channel, a sine in phase with the cycles
+            (sin 2 pi s); 0 (default) holds it at 0 (e.g. a tangential drive kept still).
+    """
+    n = _count("preload_steps", preload_steps, 1)
+    c = _count("cycles", cycles, 1)
+    k = _count("steps_per_cycle", steps_per_cycle, 2)
+    if k % 2:
+        raise ValueError(f"steps_per_cycle = {k} is invalid: it must be even (the peak of the "
+                         "cycle is an increment)")
+    lo = check_scalar("low", low, lo=0.0, hi=1.0)
+    b = check_scalar("tangential", tangential, lo=0.0, lo_open=False)
+    if shape not in ("triangle", "cosine"):
+        raise ValueError(f"shape = {shape!r} is invalid: it must be 'triangle' or 'cosine'")
+
+    def normal(t: float) -> float:
+        if t <= 1.0:
+            return lo * max(t, 0.0)
+        s = (t - 1.0) % 1.0
+        if shape == "cosine":
+            w = 0.5 * (1.0 - math.cos(2.0 * math.pi * s))
+        else:
+            w = 2.0 * s if s <= 0.5 else 2.0 - 2.0 * s
+        return lo + (1.0 - lo) * w
+
+    def drive(t: float) -> float:
+        return 0.0 if t <= 1.0 or b == 0.0 else b * math.sin(2.0 * math.pi * ((t - 1.0) % 1.0))
+
+    times = [(i + 1) / n for i in range(n)]
+    times += [1.0 + (j + 1) / k for j in range(c * k)]
+    return LoadProgram({preload: normal, cyclic: drive}, times, cycle_start=1.0)
+
+
 def cycle_index(times, program: LoadProgram) -> np.ndarray:
     """Cycle number (1, 2, ...) of each increment time, 0 before the first cycle (an increment
     ending exactly at the end of a cycle belongs to that cycle)."""
@@ -155,7 +208,8 @@ def cycle_boundaries(times, program: LoadProgram) -> np.ndarray:
     return np.r_[before[-1], ends].astype(int)
 
 
-def cycle_summary(times, program: LoadProgram, displacement, force, dissipation) -> list:
+def cycle_summary(times, program: LoadProgram, displacement, force, dissipation,
+                  normal_dissipation=None) -> list:
     """Per cycle of a cyclic program: the loop energy, the interface dissipation, the
     amplitudes, the energy ratio and the secant stiffness.
 
@@ -165,6 +219,8 @@ def cycle_summary(times, program: LoadProgram, displacement, force, dissipation)
         displacement: (n,) the driven displacement (e.g. the prescribed u_x) [mm].
         force: (n,) its work-conjugate force on the body (e.g. ``problem.reaction(tag)[0]``) [N].
         dissipation: (n,) cumulative interface dissipation [N mm].
+        normal_dissipation: (n,) cumulative normal hysteresis of a normal law with memory
+            (``Increment.normal_dissipation``) [N mm], or None.
 
     Returns:
         One dict per complete cycle (:func:`cycle_boundaries`): ``cycle``, ``loop_energy``
@@ -173,7 +229,8 @@ def cycle_summary(times, program: LoadProgram, displacement, force, dissipation)
         ``delta_amplitude`` and ``force_amplitude`` (half the peak-to-peak u and F [mm], [N]),
         ``energy_ratio`` (A = loop_energy / (4 F* delta*) [-]), ``secant_stiffness``
         ((F_max - F_min) / (u_max - u_min) over the cycle [N/mm]), ``start`` and ``end`` (its
-        increments' indices).
+        increments' indices); with ``normal_dissipation`` also ``normal_dissipated`` (the
+        normal hysteresis of the cycle [N mm]: 0 once h_min stops moving, shakedown).
     """
 
     t = np.asarray(times, dtype=float)
@@ -183,15 +240,23 @@ def cycle_summary(times, program: LoadProgram, displacement, force, dissipation)
     if not (len(t) == len(u) == len(f) == len(d)):
         raise ValueError(f"times, displacement, force and dissipation must have equal lengths, "
                          f"got {len(t)}, {len(u)}, {len(f)}, {len(d)}")
+    dn = None if normal_dissipation is None else np.asarray(normal_dissipation, dtype=float)
+    if dn is not None and dn.shape != t.shape:
+        raise ValueError(f"normal_dissipation of shape {dn.shape} must be of the times' shape "
+                         f"{t.shape}")
     b = cycle_boundaries(t, program)
     if b.size == 0:
         return []
     energy = loop_energies(u, f, b)
     du, df = loop_amplitudes(u, f, b)
     ratio = energy_ratio(energy, df, du)
-    return [dict(cycle=k + 1, loop_energy=float(energy[k]), dissipated=float(d[e] - d[s]),
-                 delta_amplitude=float(du[k]), force_amplitude=float(df[k]),
-                 energy_ratio=float(ratio[k]),
-                 secant_stiffness=float(df[k] / du[k]) if du[k] > 0 else float("nan"),
-                 start=int(s), end=int(e))
-            for k, (s, e) in enumerate(zip(b[:-1], b[1:]))]
+    out = [dict(cycle=k + 1, loop_energy=float(energy[k]), dissipated=float(d[e] - d[s]),
+                delta_amplitude=float(du[k]), force_amplitude=float(df[k]),
+                energy_ratio=float(ratio[k]),
+                secant_stiffness=float(df[k] / du[k]) if du[k] > 0 else float("nan"),
+                start=int(s), end=int(e))
+           for k, (s, e) in enumerate(zip(b[:-1], b[1:]))]
+    if dn is not None:
+        for c in out:
+            c["normal_dissipated"] = float(dn[c["end"]] - dn[c["start"]])
+    return out

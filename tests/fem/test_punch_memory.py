@@ -9,6 +9,9 @@ separation h_min), so that the test takes seconds; the tabulated population law
 
 from __future__ import annotations
 
+import sys
+from pathlib import Path
+
 import h5py
 import numpy as np
 from mpi4py import MPI
@@ -19,44 +22,12 @@ from rough_contact.io.interface_output import (InterfaceWriter, MEMORY_FIELD_NAM
 from rough_contact.scenes import flat_punch as punch
 from rough_contact.solver.loading import load_path, load_unload_factors
 
-C, LAM, DELTA = 50.0, 1e-3, 1.5e-3      # MPa, mm, mm
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))   # tests/: the shared stand-in law
+from memory_law import DELTA, MemoryLaw  # noqa: E402
+
 COARSE = dict(mesh_size=20.0, contact_size=2.5, order=1)
 STEPS = 4
 FACTORS = load_unload_factors(STEPS, STEPS - 1)      # up to 1, back to 1/4 (the seating load)
-
-
-class MemoryLaw:
-    """p = C exp(-h/LAM) on loading; p = p(h_min) x^1.5, x = 1 - (h - h_min)/DELTA unloading."""
-
-    def evaluate(self, h, curvature=False):
-        h = np.asarray(h, float)
-        p = C * np.exp(-h / LAM)
-        out = (p, p / LAM, np.minimum(p / 100.0, 1.0))
-        return out + (-p / LAM ** 2,) if curvature else out
-
-    def separation_for_pressure(self, p):
-        return -LAM * np.log(np.asarray(p, float) / C)
-
-    def evaluate_history(self, h, h_min, curvature=False):
-        h, hm = np.broadcast_arrays(np.asarray(h, float), np.asarray(h_min, float))
-        lo = np.minimum(h, hm)
-        p0 = C * np.exp(-lo / LAM)
-        x = np.clip(1.0 - (h - lo) / DELTA, 0.0, 1.0)
-        un = h > hm
-        p = np.where(un, p0 * x ** 1.5, p0)
-        k = np.where(un, 1.5 * p0 * np.sqrt(x) / DELTA, p0 / LAM)
-        a = np.minimum(p / 100.0, 1.0)
-        if curvature:
-            dk = np.where(un, -0.75 * p0 / (DELTA ** 2 * np.sqrt(np.maximum(x, 1e-300))),
-                          -p0 / LAM ** 2)
-            return p, k, a, np.where(un & (x <= 0), 0.0, dk)
-        return p, k, a
-
-    def normal_dissipation(self, h_min):
-        """D(h_min) = int_{h_min}^inf p_load - int_{h_min}^{h_min + DELTA} p_unload."""
-        hm = np.asarray(h_min, float)
-        return np.where(np.isfinite(hm), C * np.exp(-np.minimum(hm, 1e300) / LAM)
-                        * (LAM - 0.4 * DELTA), 0.0)
 
 
 def _run(comm, normal, normal_law="elastic", outdir=None):

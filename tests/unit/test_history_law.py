@@ -1,8 +1,8 @@
 """Issue 23 item 3: the normal history h_min in the interface law (commit, revert, checkpoint,
 consistent tangent, normal dissipation).
 
-The interface machinery is checked with a closed-form irreversible law written here (not the
-table): loading p_L(h) = c exp(-h/lam); unloading from h_min along
+The interface machinery is checked with a closed-form irreversible law (tests/memory_law.py,
+shared with the FE tests; not the table): loading p_L(h) = c exp(-h/lam); unloading from h_min along
 p = p_L(h_min) (1 - (h - h_min)/delta)^(3/2) (zero beyond h_min + delta). Its dissipation has
 the closed form D(h_min) = int p_L - int p_u = c exp(-h_min/lam) (lam - 2 delta/5), and the
 loop integral of p dh over a cycle is computed here by an independent trapezoid rule along
@@ -11,6 +11,8 @@ the path.
 from __future__ import annotations
 
 import pickle
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -24,37 +26,8 @@ from rough_contact.interface.friction import IsotropicSlipHardening
 from rough_contact.interface.tangential import TangentialStiffness
 from rough_contact.surface import SpectralMoments
 
-C, LAM, DELTA = 50.0, 1e-3, 1.5e-3      # MPa, mm, mm
-
-
-class ClosedFormHistoryLaw:
-    """Test double: exponential loading, Hertz-like unloading of fixed recovery DELTA."""
-
-    def evaluate(self, h, curvature=False):
-        h = np.asarray(h, float)
-        p = C * np.exp(-h / LAM)
-        out = (p, p / LAM, np.minimum(p / 100.0, 1.0))
-        return out + (-p / LAM ** 2,) if curvature else out
-
-    def evaluate_history(self, h, h_min, curvature=False):
-        h, hm = np.broadcast_arrays(np.asarray(h, float), np.asarray(h_min, float))
-        lo = np.minimum(h, hm)
-        p0 = C * np.exp(-lo / LAM)
-        x = np.clip(1.0 - (h - lo) / DELTA, 0.0, 1.0)
-        un = h > hm
-        p = np.where(un, p0 * x ** 1.5, p0)
-        k = np.where(un, 1.5 * p0 * np.sqrt(x) / DELTA, p0 / LAM)
-        a = np.minimum(p / 100.0, 1.0)
-        if curvature:
-            dk = np.where(un, np.where(x > 0, -0.75 * p0 / (DELTA ** 2 * np.sqrt(np.maximum(x, 1e-300))), 0.0),
-                          -p0 / LAM ** 2)
-            return p, k, a, dk
-        return p, k, a
-
-    def normal_dissipation(self, h_min):
-        hm = np.asarray(h_min, float)
-        return np.where(np.isfinite(hm), C * np.exp(-np.minimum(hm, 1e300) / LAM)
-                        * (LAM - 0.4 * DELTA), 0.0)
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))   # tests/: the shared stand-in law
+from memory_law import C, DELTA, LAM, MemoryLaw as ClosedFormHistoryLaw  # noqa: E402
 
 
 def _law(friction=False):

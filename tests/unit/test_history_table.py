@@ -210,3 +210,17 @@ def test_taper_beyond_the_table_is_finite_when_p_underflows_at_its_end():
         for v in (p, k, a, dk):
             assert np.all(np.isfinite(v))
         assert np.all(p >= 0) and np.all(k >= 0) and np.all(p < 1e-300)
+
+
+def test_pickle_roundtrip_and_old_format_refused():
+    import pickle
+    law = _synthetic(_rho, _drho, _la, _dla)
+    back = pickle.loads(pickle.dumps(law))
+    hm = np.linspace(law.h_min, law.h_table_end, 30)
+    h = hm + 0.7 * SIG
+    for x, y in zip(law.evaluate_history(h, hm), back.evaluate_history(h, hm)):
+        np.testing.assert_array_equal(x, y)
+    np.testing.assert_array_equal(law.normal_dissipation(hm), back.normal_dissipation(hm))
+    old = object.__new__(HistoryNormalLaw)
+    with pytest.raises(ValueError, match="older format"):
+        old.__setstate__({"loading": law.loading, "_C": np.zeros((1, 1, 4, 4)), "_dm": 1.0})
