@@ -307,7 +307,8 @@ class HistoryNormalLaw:
         Args:
             surface: SpectralMoments; material: AsperityMaterial (resolved on surface here).
             rtol: relative accuracy of p, k and A/A0 on the unloading branch against the direct
-                sums (``micro.unloading._row_sums`` with the same n_quad, n_t), in [1e-8, 0.1];
+                sums (``micro.unloading._row_sums`` with the same n_quad, n_t, n_zeta), in
+                [1e-8, 0.1];
                 half of it is given to the x direction (cell midpoints on the first rows), half
                 to the h_min direction (row midpoints at every other x knot).
             loading: a prebuilt ``NormalLaw.elasto_plastic`` of the same surface and material
@@ -385,11 +386,12 @@ class HistoryNormalLaw:
             span, beta = hE - hL, _GRADING
             rows0 = _row_h(np.linspace(0.0, 1.0, nm + 1), hL, span, beta)
             passed: set = set()
+            worst_pass = 0.0                       # worst error of the cells that passed
             while True:
                 m = model(rows0, xk)
                 xm = 0.5 * (xk[:-1] + xk[1:])
                 todo = [j for j in range(xm.size) if round(float(xm[j]), 12) not in passed]
-                worst_x = 0.0
+                worst_x = worst_pass
                 split = []
                 if todo:
                     ref = model(rows0, xm[todo])
@@ -397,14 +399,14 @@ class HistoryNormalLaw:
                     va, _ = _hermite_mid(m[2], m[3], xk)
                     for c, j in enumerate(todo):
                         e = _rel_errors(v[:, j], dv[:, j], va[:, j], ref[:3, :, c], tail)
+                        worst_x = max(worst_x, e)
                         if e > 0.5 * rtol:
                             split.append(xm[j])
                         else:
                             passed.add(round(float(xm[j]), 12))
-                            worst_x = max(worst_x, e)
+                            worst_pass = max(worst_pass, e)
                 if not split:
                     break
-                worst_x = np.inf
                 xk = np.sort(np.concatenate([xk, split]))
             # 2. rows: doubled until the row midpoints pass at every other x knot (and the
             #    last); the checked points become knots of the next rows if they fail
