@@ -120,6 +120,8 @@ def run_ep(z, size, Y, p_max, nz, depth, tol):
     seq = [("loading", f) for f in LOAD] + [("unloading", f) for f in UNLOAD] \
         + [("reloading", f) for f in RELOAD]
     for br, f in seq:
+        if f < 0.1:    # a contact of one or two pixels: Tamaas' PKR error is NaN there
+            continue
         t = time.perf_counter()
         epic.solve(f * p_max)
         u = np.array(model.displacement)[0, :, :, 2]
@@ -159,8 +161,10 @@ def statistical(z, size, mat, p_max):
 
 def closure(rows, f_ref=0.01):
     """Loading minus unloading separation at the same load f_ref p_max (both solved there)."""
-    pick = lambda br: [r for r in rows if r["branch"] == br and abs(r["f"] - f_ref) < 1e-12][0]  # noqa: E731
-    return pick("loading")["d"] - pick("unloading")["d"]
+    def pick(br):
+        r = [r for r in rows if r["branch"] == br and abs(r["f"] - f_ref) < 1e-12]
+        return r[0]["d"] if r else np.nan
+    return pick("loading") - pick("unloading")
 
 
 def main(argv=None):
@@ -211,18 +215,20 @@ def main(argv=None):
             rows.append({"model": name, "branch": r["branch"], "p/p_max": r["f"],
                          "d [um]": r["d"] * 1e3, "d/sigma": r["d"] / sig, "p [MPa]": r["p"],
                          "A/A0": r["a"], "k [MPa/mm]": r["k"]})
-    print(f"\n{'model':24s} {'closure at p_max/100':>22s} {'k_unload/k_load at p_max':>25s}")
+    print(f"\n{'model':24s} {'closure at p_max/100':>22s} {'closure at p_max/10':>22s} "
+          f"{'k_unload/k_load at p_max':>25s}")
     summary = {}
     for name, (rs, info) in out.items():
-        c = closure(rs)
+        c, c10 = closure(rs), closure(rs, 0.1)
         ld = [r for r in rs if r["branch"] == "loading"]
         kl = fd_stiffness([r["d"] for r in ld], [r["p"] for r in ld], len(ld) - 1)
         un = [r for r in rs if r["branch"] == "unloading"]
         ku = info.get("k_unload")
         if ku is None:             # FD of the first unloading step
             ku = (un[0]["p"] - ld[-1]["p"]) / (ld[-1]["d"] - un[0]["d"])
-        summary[name] = (c, ku / kl)
-        print(f"{name:24s} {c / sig:10.3f} sigma {c * 1e3:7.4f} um {ku / kl:25.3f}")
+        summary[name] = (c if np.isfinite(c) else c10, ku / kl)
+        print(f"{name:24s} {c / sig:10.3f} sigma {c * 1e3:7.4f} um {c10 / sig:10.3f} sigma "
+              f"{c10 * 1e3:7.4f} um {ku / kl:25.3f}")
     write_csv(a.out, rows)
     figure(out, summary, os.path.join(DOCS, "figures", "hysteresis_bem.png"), a.p_max)
     print(f"\nwrote {os.path.relpath(a.out)}, docs/figures/hysteresis_bem.png")
