@@ -49,8 +49,8 @@ from rough_contact.surface.spectrum import SpectrumShape, fit_spectrum
 HERE = os.path.dirname(os.path.abspath(__file__))
 DOCS = os.path.join(HERE, "..", "docs")
 NU = 0.3
-LOAD = (0.01, 0.03, 0.1, 0.25, 0.5, 0.75, 1.0)                       # loading steps / p_max
-UNLOAD = (0.75, 0.5, 0.25, 0.1, 0.03, 0.01)              # unloading steps / p_max
+LOAD = (0.01, 0.03, 0.1, 0.25, 0.5, 0.75, 0.9, 1.0)                       # loading steps / p_max
+UNLOAD = (0.9, 0.75, 0.5, 0.25, 0.1, 0.03, 0.01)              # unloading steps / p_max
 RELOAD = (0.25, 0.5, 0.75, 1.0, 1.15, 1.3)               # reloading steps / p_max
 
 
@@ -194,11 +194,15 @@ def main(argv=None):
     m = out["statistical"][1]["moments"]
     print(f"statistical ({time.perf_counter() - t:.0f} s): map moments sigma = "
           f"{m.rq * 1e3:.4f} um, alpha = {m.alpha1:.2f}, {m.alpha2:.2f}, psi = {out['statistical'][1]['psi']:.3f}")
-    t = time.perf_counter()
-    out["BEM saturated + memory"] = run_saturated(z, size, mat.ch * H, a.p_max)
-    print(f"saturated BEM ({time.perf_counter() - t:.0f} s): removed volume "
-          f"{out['BEM saturated + memory'][1]['removed_volume'] * 1e6:.3g} nm (mean), "
-          f"restart check d(p_max) {out['BEM saturated + memory'][1]['d_check']:.2g} mm")
+    # the cap: ch H (the fully plastic summit pressure of the statistical model: flow only
+    # there) and K_Y Y = (2/pi) H (the peak Hertz pressure at first yield: flow from the onset)
+    for cname, cap in (("ch H", mat.ch * H), ("K_Y Y", mat.yield_pressure)):
+        t = time.perf_counter()
+        name = f"BEM cap {cname} + memory"
+        out[name] = run_saturated(z, size, cap, a.p_max)
+        print(f"saturated BEM, cap {cname} = {cap:.0f} MPa ({time.perf_counter() - t:.0f} s): "
+              f"removed volume {out[name][1]['removed_volume'] * 1e6:.3g} nm (mean), "
+              f"restart check d(p_max) {out[name][1]['d_check']:.2g} mm")
     if a.ep:
         t = time.perf_counter()
         out["Tamaas elastic-plastic"] = run_ep(z, size, Y, a.p_max, a.nz, a.depth, a.ep_tol)
@@ -216,19 +220,19 @@ def main(argv=None):
                          "d [um]": r["d"] * 1e3, "d/sigma": r["d"] / sig, "p [MPa]": r["p"],
                          "A/A0": r["a"], "k [MPa/mm]": r["k"]})
     print(f"\n{'model':24s} {'closure at p_max/100':>22s} {'closure at p_max/10':>22s} "
-          f"{'k_unload/k_load at p_max':>25s}")
+          f"{'k_u/k_l at p_max, FD':>21s} {'exact k_u':>10s}")
     summary = {}
     for name, (rs, info) in out.items():
         c, c10 = closure(rs), closure(rs, 0.1)
-        ld = [r for r in rs if r["branch"] == "loading"]
-        kl = fd_stiffness([r["d"] for r in ld], [r["p"] for r in ld], len(ld) - 1)
-        un = [r for r in rs if r["branch"] == "unloading"]
-        ku = info.get("k_unload")
-        if ku is None:             # FD of the first unloading step
-            ku = (un[0]["p"] - ld[-1]["p"]) / (ld[-1]["d"] - un[0]["d"])
+        ld = [r for r in rs if r["branch"] == "loading" and r["f"] >= 0.75]
+        un = [r for r in rs if r["branch"] == "unloading" and r["f"] >= 0.75][::-1]
+        # the same three-point rule on both branches: (0.75, 0.9, 1) p_max
+        kl = fd_stiffness([r["d"] for r in ld], [r["p"] for r in ld], 2)
+        ku = fd_stiffness([r["d"] for r in un + ld[-1:]], [r["p"] for r in un + ld[-1:]], 2)
+        ke = info.get("k_unload", np.nan)
         summary[name] = (c if np.isfinite(c) else c10, ku / kl)
         print(f"{name:24s} {c / sig:10.3f} sigma {c * 1e3:7.4f} um {c10 / sig:10.3f} sigma "
-              f"{c10 * 1e3:7.4f} um {ku / kl:25.3f}")
+              f"{c10 * 1e3:7.4f} um {ku / kl:21.3f} {ke / kl:10.3f}")
     write_csv(a.out, rows)
     figure(out, summary, os.path.join(DOCS, "figures", "hysteresis_bem.png"), a.p_max)
     print(f"\nwrote {os.path.relpath(a.out)}, docs/figures/hysteresis_bem.png")
