@@ -202,7 +202,8 @@ def main(argv=None):
         out[name] = run_saturated(z, size, cap, a.p_max)
         print(f"saturated BEM, cap {cname} = {cap:.0f} MPa ({time.perf_counter() - t:.0f} s): "
               f"removed volume {out[name][1]['removed_volume'] * 1e6:.3g} nm (mean), "
-              f"restart check d(p_max) {out[name][1]['d_check']:.2g} mm")
+              f"restart check d(p_max) {out[name][1]['d_check']:.2g} mm, load share at the cap "
+              f"at p_max {out[name][0][len(LOAD) - 1]['sat'] * cap / a.p_max:.3f}")
     if a.ep:
         t = time.perf_counter()
         out["Tamaas elastic-plastic"] = run_ep(z, size, Y, a.p_max, a.nz, a.depth, a.ep_tol)
