@@ -39,7 +39,7 @@ import time
 import numpy as np
 
 from _common import write_csv
-from bench_hysteresis import E_STAR, S1, Loop
+from bench_hysteresis import E_STAR, S1, Loop, plastic_share
 
 from rough_contact.micro.asperity import AsperityMaterial
 from rough_contact.micro.bem import HalfSpace, NumpySolver, _post_process
@@ -156,7 +156,8 @@ def statistical(z, size, mat, p_max):
                 p, k, a = (v[0] for v in loop.unload(h, h_min))
             rows.append(dict(branch=br, f=f, d=h, p=p, a=a, k=k, sat=np.nan))
     k_un = loop.unload(h_min, h_min)[1][0]
-    return rows, {"k_unload": k_un, "moments": m, "psi": m.plasticity_index(E_STAR, mat.H)}
+    return rows, {"k_unload": k_un, "moments": m, "psi": m.plasticity_index(E_STAR, mat.H),
+                  "yielded_share": plastic_share(loop, h_min)}
 
 
 def closure(rows, f_ref=0.01):
@@ -179,6 +180,7 @@ def main(argv=None):
     ap.add_argument("--depth", type=float, default=0.04, help="Tamaas volume depth [mm]")
     ap.add_argument("--ep-tol", type=float, default=1e-6)
     ap.add_argument("--out", default=os.path.join(DOCS, "hysteresis_bem.csv"))
+    ap.add_argument("--fig", default=os.path.join(DOCS, "figures", "hysteresis_bem.png"))
     a = ap.parse_args(argv)
     mat = AsperityMaterial(E_star=E_STAR, psi=a.psi).resolve(S1)
     H = mat.H
@@ -194,6 +196,13 @@ def main(argv=None):
     m = out["statistical"][1]["moments"]
     print(f"statistical ({time.perf_counter() - t:.0f} s): map moments sigma = "
           f"{m.rq * 1e3:.4f} um, alpha = {m.alpha1:.2f}, {m.alpha2:.2f}, psi = {out['statistical'][1]['psi']:.3f}")
+    # how much load sits on yielded contacts at p_max: summits beyond omega_c (statistical) vs
+    # pixels of the ELASTIC BEM solution above the first-yield peak pressure K_Y Y
+    K = HalfSpace(z.shape, size, E_STAR, NU)
+    pe = NumpySolver(z, K, None, tol=1e-9).solve(a.p_max)
+    print(f"load share on yielded contacts at p_max: statistical (summits beyond omega_c) "
+          f"{out['statistical'][1]['yielded_share']:.3f}, elastic BEM (pixels above K_Y Y) "
+          f"{pe[pe > mat.yield_pressure].sum() / pe.sum():.3f}")
     # the cap: ch H (the fully plastic summit pressure of the statistical model: flow only
     # there) and K_Y Y = (2/pi) H (the peak Hertz pressure at first yield: flow from the onset)
     for cname, cap in (("ch H", mat.ch * H), ("K_Y Y", mat.yield_pressure)):
@@ -235,8 +244,8 @@ def main(argv=None):
         print(f"{name:24s} {c / sig:10.3f} sigma {c * 1e3:7.4f} um {c10 / sig:10.3f} sigma "
               f"{c10 * 1e3:7.4f} um {ku / kl:21.3f} {ke / kl:10.3f}")
     write_csv(a.out, rows)
-    figure(out, summary, os.path.join(DOCS, "figures", "hysteresis_bem.png"), a.p_max)
-    print(f"\nwrote {os.path.relpath(a.out)}, docs/figures/hysteresis_bem.png")
+    figure(out, summary, a.fig, a.p_max)
+    print(f"\nwrote {os.path.relpath(a.out)}, {os.path.relpath(a.fig)}")
 
 
 def figure(out, summary, path, p_max):
