@@ -18,7 +18,8 @@ The cycle: load to p_max, unload to p_max/1000, reload to 1.3 p_max. Printed tab
    (k_unload/k_load at p = 1 ... 300 MPa).
 
 Writes docs/hysteresis_loops.csv (the loop curves), docs/hysteresis_stiffness.csv (table 2) and
-docs/figures/hysteresis_loops.png. Run (about 1 min):
+docs/figures/hysteresis_loops.png. Run (~8 min on 2 loaded cores, mostly root finding on the
+loading sums):
 
     PYTHONPATH=. python benchmarks/bench_hysteresis.py
 """

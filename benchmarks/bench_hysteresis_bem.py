@@ -32,7 +32,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import os
 import time
 
@@ -204,7 +203,8 @@ def main(argv=None):
           f"{out['statistical'][1]['yielded_share']:.3f}, elastic BEM (pixels above K_Y Y) "
           f"{pe[pe > mat.yield_pressure].sum() / pe.sum():.3f}")
     # the cap: ch H (the fully plastic summit pressure of the statistical model: flow only
-    # there) and K_Y Y = (2/pi) H (the peak Hertz pressure at first yield: flow from the onset)
+    # there) and K_Y Y = (2/pi) H (the peak Hertz pressure at first yield: flow from the
+    # onset)
     for cname, cap in (("ch H", mat.ch * H), ("K_Y Y", mat.yield_pressure)):
         t = time.perf_counter()
         name = f"BEM cap {cname} + memory"
