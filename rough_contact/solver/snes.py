@@ -369,7 +369,8 @@ class SNESSolver:
             name += f"({pc.getFactorSolverType()})"
         return name
 
-    def solve(self, atol: Optional[float] = None) -> SolveResult:
+    def solve(self, atol: Optional[float] = None,
+              reference: Optional[float] = None) -> SolveResult:
         """Solve F(u) = 0 starting from ``problem.u``; on success ``problem.u`` holds the root.
 
         With a :class:`Continuation` and a law that can be softened, a solve that has not
@@ -383,6 +384,12 @@ class SNESSolver:
                 (the augmented-Lagrangian re-solves of a load step use the first solve's
                 rtol x initial residual: a re-solve starts from a small residual, and its
                 own rtol would ask for more accuracy than the step's first solve reached).
+            reference: if given, the residual norm [N] the relative tolerance refers to at most:
+                the (full-law) solve stops at rtol x min(initial residual, reference). The load
+                stepping passes the residual at the last converged state under the new load, so
+                that a predicted start with a larger residual (a secant extrapolation far beyond
+                the last increment, e.g. 200x from the seating step into an exponential law)
+                changes the iteration count, not the accuracy.
 
         Raises:
             Exception: whatever a callback raised (the same object, e.g. a ConvergenceError
@@ -392,7 +399,7 @@ class SNESSolver:
         interface = self.problem.interface
         cont = self.continuation
         if cont is None or interface is None or not interface.softenable:
-            return self._solve(atol)
+            return self._solve(atol, reference)
         stages, parts = [], []
         if cont.after is None or cont.after > 0:
             u0 = self.problem.solution_vector().copy()
@@ -400,7 +407,7 @@ class SNESSolver:
             self.snes.setTolerances(max_it=max_it if cont.after is None
                                     else min(cont.after, max_it))
             try:
-                first = self._solve(atol)
+                first = self._solve(atol, reference)
             except ConvergenceError:
                 first = SolveResult(False, 0, "CONVERGENCE_ERROR",
                                     self.snes.getIterationNumber(), [],
@@ -425,7 +432,7 @@ class SNESSolver:
         finally:
             interface.set_softening(1.0)
         if parts[-1].converged:
-            r = self._solve(atol)
+            r = self._solve(atol, reference)
             stages.append((1.0, r.iterations, r.converged))
             parts.append(r)
         last = parts[-1]
@@ -434,7 +441,7 @@ class SNESSolver:
                            [x for p in parts for x in p.residuals],
                            sum(p.linear_iterations for p in parts), stages)
 
-    def _solve(self, atol: Optional[float]) -> SolveResult:
+    def _solve(self, atol: Optional[float], reference: Optional[float] = None) -> SolveResult:
         """One Newton solve of the current law (see :meth:`solve`)."""
         self._residuals = []
         if self.problem.A is not self._A:          # new pattern after a re-pairing
@@ -455,6 +462,15 @@ class SNESSolver:
             if atol > atol_now:
                 atol_before = atol_now
                 self.snes.setTolerances(atol=atol)
+        rtol_before = None
+        if reference is not None:
+            # SNES measures rtol against the residual at the start, which a predicted start
+            # may have inflated: refer it to the smaller of the two
+            self.problem.F(self.snes, self.x, self.problem.b)
+            f0 = self.problem.b.norm()
+            if np.isfinite(f0) and f0 > reference > 0.0:
+                rtol_before = self.snes.getTolerances()[0]
+                self.snes.setTolerances(rtol=rtol_before * reference / f0)
         # Some options are read only when the preconditioner is set up, inside the solve.
         self.problem.callback_error = None
         try:
@@ -470,6 +486,8 @@ class SNESSolver:
         finally:
             if atol_before is not None:
                 self.snes.setTolerances(atol=atol_before)
+            if rtol_before is not None:
+                self.snes.setTolerances(rtol=rtol_before)
         reason = self.snes.getConvergedReason()
         self.problem.update_solution(self.x)
         if not self._reported_after_first_solve:   # a typo shows now, not at the end of a run
