@@ -387,9 +387,9 @@ class _Stepper:
         reference = None
         if (self.predictor == "secant" and self.u_previous is not None
                 and (lam - lam_n) * (lam_n - lam_p) > 0.0):
-            # the residual at u_n under the new load: the Newton tolerance refers to it at most,
-            # so the predictor changes the iteration count, not the accuracy of the result
-            reference = _residual_norm(problem)
+            # the Newton tolerance refers at most to the residual at u_n under the new load, so
+            # the predictor changes the iteration count, not the accuracy of the result
+            reference = self.u_committed
             # u0 = u_n + r (u_n - u_{n-1}), r = (lam - lam_n) / (lam_n - lam_{n-1})
             r = (lam - lam_n) / (lam_n - lam_p)
             u = problem.solution_vector()
@@ -539,19 +539,8 @@ def _validity_guard(inc: Increment, policy: str) -> None:
     warnings.warn(msg, ModelValidityWarning, stacklevel=3)
 
 
-def _residual_norm(problem: ContactProblem) -> float:
-    """2-norm of the residual at the current solution and load factor [N] (collective)."""
-    x = problem.solution_vector()
-    b = problem.b.duplicate()
-    try:
-        problem.F(None, x, b)
-        return float(b.norm())
-    finally:
-        b.destroy()
-
-
 def _solve_step(problem: ContactProblem, solver: SNESSolver, comm: MPI.Comm,
-                reference: Optional[float] = None):
+                reference: Optional[PETSc.Vec] = None):
     """Solve one load step: a Newton solve, then ``interface.accept`` at the converged iterate;
     while an enforcement with multipliers updates them (``Acceptance.done`` False), another
     Newton solve from the current iterate. ``reference``: see ``SNESSolver.solve``.
@@ -579,18 +568,19 @@ def _solve_step(problem: ContactProblem, solver: SNESSolver, comm: MPI.Comm,
             return False, total, failure, updates
         updates += 1
         first = total.residuals[0] if total.residuals else 0.0
-        if reference is not None:
-            first = min(first, reference)
+        if total.reference_norm is not None:
+            first = min(first, total.reference_norm)
         ok, result, failure = _attempt(solver, comm, atol=solver.snes.getTolerances()[0] * first)
         total = SolveResult(result.converged, result.reason, result.reason_name,
                             total.iterations + result.iterations,
                             total.residuals + result.residuals,
-                            total.linear_iterations + result.linear_iterations)
+                            total.linear_iterations + result.linear_iterations,
+                            reference_norm=total.reference_norm)
     return ok, total, failure, updates
 
 
 def _attempt(solver: SNESSolver, comm: MPI.Comm, atol: Optional[float] = None,
-             reference: Optional[float] = None):
+             reference: Optional[PETSc.Vec] = None):
     """One Newton solve (``atol``, ``reference``: see ``SNESSolver.solve``). Returns
     ``(converged on every rank, SolveResult or None, the ConvergenceError or None)``; every
     other exception propagates."""
