@@ -22,10 +22,21 @@ cheapest one that needs the population integral; McCool's GW table is a closed f
 
     OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bench_advisor.py [--tolerance 0.05]
         [--surfaces ...] [--scenes punch beam] [--csv FILE] [--results ...] [--cost-only]
+        [--cold N] [--bem-check]
 
 ``--cost-only`` skips the FE runs and prints only the advisor's own cost against the elastic
 table's build of the same surface and modulus (each the fastest of ``--repeat`` interleaved
-runs, so that a busy machine slows both alike).
+runs, so that a busy machine slows both alike). These are warm calls: the process has already
+run the advisor once.
+
+``--cold N`` measures what a run meets instead (the demos call the advisor once per process):
+per surface and scene, N pairs of fresh processes, interleaved: one calls the advisor (the
+first population sum of the process, then the same call again, warm) and builds the elastic
+table; the other builds the table alone. The first population sum of a process pays one-time
+costs (importing scipy.interpolate, the cached spline of the asperity shape factors, quadrature
+nodes) which the table build pays when it comes first; the run's extra time for the advisor is
+the first process's advisor + build minus the second's build. CPU time of each process (a
+shared machine inflates wall times unevenly), medians of N.
 
 Units: mm, N, MPa.
 """
@@ -160,6 +171,123 @@ def cost_only(cases, scenes, tolerance, results, repeat):
     return rows
 
 
+_COLD_CHILD = r"""
+import json, sys, time, warnings
+from rough_contact.advisor import advise
+from rough_contact.interface.normal import NormalLaw
+from rough_contact.micro.asperity import AsperityMaterial
+from rough_contact.surface import SpectralMoments
+spec = json.loads(sys.argv[1])
+surface = SpectralMoments(**spec["surface"], unit="mm")
+material = AsperityMaterial(**spec["material"])
+out = {}
+
+
+def timed(name, f):
+    w, c = time.perf_counter(), time.process_time()
+    f()
+    out[name] = (time.perf_counter() - w, time.process_time() - c)
+
+
+with warnings.catch_warnings():
+    warnings.simplefilter("ignore", UserWarning)
+    call = lambda: advise(surface, material, spec["p_range"], spec["tolerance"],  # noqa: E731
+                          results=spec["results"])
+    if spec["advise"]:
+        timed("advisor", call)            # the first population sum of the process
+        timed("advisor_again", call)      # warm
+    timed("build", lambda: NormalLaw.elastic(surface, material.E_star))
+print(json.dumps(out))
+"""
+
+
+def cold(cases, scenes, tolerance, results, n):
+    """The advisor as a run meets it: fresh processes (see the module docstring)."""
+    import json
+    import os
+    import subprocess
+
+    def child(spec):
+        out = subprocess.run([sys.executable, "-c", _COLD_CHILD, json.dumps(spec)],
+                             capture_output=True, text=True, check=True,
+                             env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))
+        return json.loads(out.stdout.splitlines()[-1])
+
+    rows = []
+    for name, (surface, mdata) in cases:
+        for scene, (E, nu, p_range) in scenes.items():
+            spec = dict(surface=dict(m00=surface.m00, m20=surface.m20, m02=surface.m02,
+                                     m40=surface.m40, m04=surface.m04),
+                        material=dict(E_star=E, nu=nu, **mdata), p_range=list(p_range),
+                        tolerance=tolerance, results=list(results))
+            a, b = [], []
+            for _ in range(n):      # interleaved: a busy machine slows both alike
+                a.append(child(dict(spec, advise=True)))
+                b.append(child(dict(spec, advise=False)))
+            row = dict(surface=name, scene=scene)
+            for k, i in (("wall", 0), ("cpu", 1)):
+                med = lambda key, runs: float(np.median([r[key][i] for r in runs]))  # noqa
+                first, again = med("advisor", a), med("advisor_again", a)
+                alone = med("build", b)
+                # the run's extra time: advisor then build, against the build alone
+                marginal = float(np.median([r["advisor"][i] + r["build"][i] for r in a])) - alone
+                row.update({f"first_{k}": first, f"again_{k}": again, f"build_{k}": alone,
+                            f"marginal_{k}": marginal})
+            rows.append(row)
+            print(f"-> {row}", flush=True)
+    print("\n| surface | scene | advisor, first call of the process [ms] | the same call again "
+          "[ms] | elastic table build, first in its process [s] | first call / build | run's "
+          "extra time: advisor + build minus build alone [ms] | / build |")
+    print("|---|---|---|---|---|---|---|---|")
+    for r in rows:
+        print(f"| {r['surface']} | {r['scene']} | {r['first_cpu'] * 1e3:.0f} "
+              f"| {r['again_cpu'] * 1e3:.0f} | {r['build_cpu']:.2f} "
+              f"| {r['first_cpu'] / r['build_cpu']:.1%} | {r['marginal_cpu'] * 1e3:.0f} "
+              f"| {r['marginal_cpu'] / r['build_cpu']:.1%} |")
+    print("(CPU time of each process, medians of the runs; wall times in the CSV)")
+    return rows
+
+
+# (example surface, p_min, p_max [MPa], pixels per shortest wavelength) of --bem-check
+BEM_CHECK_CASES = [("anisotropic", 8.0, 40.0, 4.0), ("anisotropic", 120.0, 350.0, 4.0),
+                   ("self-affine", 5.0, 30.0, 2.0), ("paper", 5.0, 50.0, 2.0)]
+
+
+def bem_check_table(tolerance, results):
+    """advise(..., bem_check=...) on the example surfaces of docs/bem.md (E* = 1.067e5 MPa,
+    psi = 0.35): the check's figures, verdict and cost beside the measured-figures verdict."""
+    from rough_contact.advisor import BEMCheck
+
+    rows = []
+    for name, p0, p1, ppw in BEM_CHECK_CASES:
+        s = example_surfaces()[name][0]
+        mat = AsperityMaterial(E_star=1.067e5, nu=0.3, psi=0.35)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", UserWarning)
+            plain = advise(s, mat, (p0, p1), tolerance, results=results)
+            adv = advise(s, mat, (p0, p1), tolerance, results=results,
+                         bem_check=BEMCheck(pixels_per_wavelength=ppw, cache=False))
+        c = adv.bem_check
+        app = c.approach_ratio[1:]
+        rows.append(dict(surface=name, p_range=f"{p0:g}-{p1:g}", grid=f"{c.grid[0]}x{c.grid[1]}",
+                         k_ratio=f"{c.stiffness_ratio.min():.3g}-{c.stiffness_ratio.max():.3g}",
+                         k_se=f"{c.stiffness_se.min():.1%}-{c.stiffness_se.max():.1%}",
+                         approach=f"{app.min():.3g}-{app.max():.3g}",
+                         p_at_h=f"{c.pressure_ratio.min():.3g}-{c.pressure_ratio.max():.3g}",
+                         verdict=c.verdict, measured=plain.normal, advised=adv.normal,
+                         seconds=c.seconds))
+        print(f"-> {rows[-1]}", flush=True)
+    print("\n| surface | p range [MPa] | grid (8 realisations) | k stat/BEM at equal load "
+          "| s.e. | approach | p(h) (information) | check | advised without / with the check "
+          "| check [s] |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    for r in rows:
+        print(f"| {r['surface']} | {r['p_range']} | {r['grid']} | {r['k_ratio']} | {r['k_se']} "
+              f"| {r['approach']} | {r['p_at_h']} | {r['verdict']} | {r['measured']} / "
+              f"{r['advised']} | {r['seconds']:.1f} |")
+    return rows
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0], allow_abbrev=False)
     ap.add_argument("--tolerance", type=float, default=0.05)
@@ -174,6 +302,12 @@ def main(argv=None):
     ap.add_argument("--cost-only", action="store_true",
                     help="only the advisor's cost against the elastic table build (no FE)")
     ap.add_argument("--repeat", type=int, default=3, help="--cost-only: runs of each timing")
+    ap.add_argument("--bem-check", action="store_true",
+                    help="only the small BEM check (bem_check=True) on docs/bem.md's example "
+                         "surfaces (needs Tamaas), no FE")
+    ap.add_argument("--cold", type=int, default=None, metavar="N",
+                    help="only the advisor's cost as a run meets it: N pairs of fresh "
+                         "processes (module docstring), no FE")
     args, _ = ap.parse_known_args(argv)
     comm = MPI.COMM_WORLD
     cases = list(surfaces().items())
@@ -189,6 +323,16 @@ def main(argv=None):
                                             beam.PRESSURE_CONCENTRATION))}
     scenes = {k: v for k, v in scenes.items() if k in args.scenes}
     results = tuple(args.results)
+    if args.bem_check:
+        rows = bem_check_table(args.tolerance, results)
+        if args.csv:
+            write_csv(args.csv, rows)
+        return
+    if args.cold is not None:
+        rows = cold(cases, scenes, args.tolerance, results, args.cold)
+        if args.csv:
+            write_csv(args.csv, rows)
+        return
     if args.cost_only:
         rows = cost_only(cases, scenes, args.tolerance, results, args.repeat)
         if args.csv:

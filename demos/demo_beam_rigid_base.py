@@ -49,7 +49,8 @@ from __future__ import annotations
 
 import argparse
 
-from _common import DOF_THRESHOLD_HELP, parse_known, start
+from _common import (DOF_THRESHOLD_HELP, add_law_auto_arguments, law_auto_options,
+                     parse_known, start)
 
 TABLE4_CASES = [1, 2, 3, 4, 5, 6]  # m00 = 0.625, 0.3125, 0.0625 um^2; elastic, elasto-plastic
 
@@ -80,14 +81,8 @@ def parse_args(argv):
     parser.add_argument("--hardness", default="psi", choices=["psi", "tabor"],
                         help="elasto-plastic asperity hardness: from psi = 0.35 (default) or "
                         "H = Y/0.354")
-    parser.add_argument("--law", default="table4", choices=["table4", "auto"],
-                        help="normal law: each case's own (Table 4), or auto: the law advisor "
-                        "picks the cheapest within --tolerance of the full model for the case's "
-                        "surface (report printed and written to OUTDIR/caseN/advice.txt, "
-                        "advice.json; docs/advisor.md)")
-    parser.add_argument("--tolerance", type=float, default=0.05,
-                        help="--law auto: accepted relative difference from the full model in "
-                        "k, A/A0, interface approach and frictional dissipation (docs/advisor.md)")
+    add_law_auto_arguments(parser, ["table4"], "table4", "normal law: each case's own "
+                           "(Table 4)", "OUTDIR/caseN/advice.txt, advice.json")
     parser.add_argument("--outdir", default="results/beam")
     parser.add_argument("--figdir", default=None, help="also copy the figures here "
                         "(e.g. docs/figures)")
@@ -110,5 +105,5 @@ if __name__ == "__main__":
         tangential=args.tangential, friction=args.friction, hardness=args.hardness,
         outdir=args.outdir, figdir=args.figdir, fig_suffix=args.fig_suffix,
         dof_threshold=args.dof_threshold, xdmf=not args.no_xdmf, overwrite=True, law=args.law,
-        tolerance=args.tolerance)
+        **law_auto_options(args))
 

@@ -44,7 +44,8 @@ from __future__ import annotations
 
 import argparse
 
-from _common import DOF_THRESHOLD_HELP, parse_known, start
+from _common import (DOF_THRESHOLD_HELP, add_law_auto_arguments, law_auto_options,
+                     parse_known, start)
 
 
 def parse_args(argv):
@@ -61,14 +62,8 @@ def parse_args(argv):
                         help="half-width of the central load patch on the punch top [mm]")
     parser.add_argument("--steps", type=int, default=16, help="loading increments")
     parser.add_argument("--no-unload", action="store_true")
-    parser.add_argument("--law", default="rough", choices=["rough", "penalty", "auto"],
-                        help="rough (the --normal-law given), a penalty stand-in, or auto: the "
-                        "law advisor picks the cheapest normal law within --tolerance of the "
-                        "full model over the run's pressures (report printed and written to "
-                        "OUTDIR/advice.txt, advice.json; docs/advisor.md)")
-    parser.add_argument("--tolerance", type=float, default=0.05,
-                        help="--law auto: accepted relative difference from the full model in "
-                        "k, A/A0, interface approach and frictional dissipation (docs/advisor.md)")
+    add_law_auto_arguments(parser, ["rough", "penalty"], "rough", "rough (the --normal-law "
+                           "given), a penalty stand-in", "OUTDIR/advice.txt, advice.json")
     parser.add_argument("--case", default="b", choices=["a", "b", "c", "none"],
                         help="friction case of Fig 18")
     parser.add_argument("--normal-law", default="elasto-plastic",
@@ -107,5 +102,5 @@ if __name__ == "__main__":
         law=args.law, case=args.case, normal_law=args.normal_law, outdir=args.outdir,
         dof_threshold=args.dof_threshold, overwrite=True, validity=args.validity,
         checkpoint=args.checkpoint, restart=args.restart, stop_after=args.stop_after,
-        tolerance=args.tolerance)
+        **law_auto_options(args))
 

@@ -410,21 +410,24 @@ def deflection_profile(comm, setup, uN_nodes, n_samples=251):
 # ## One case
 def run_case(comm, setup, case, steps=16, tangential="mindlin", friction="b", hardness="psi",
              outdir="results/beam", prefix="rc_", dof_threshold=None, verbose=True, xdmf=True,
-             beam_modulus=E1, overwrite=False, law="table4", tolerance=0.05):
+             beam_modulus=E1, overwrite=False, law="table4", tolerance=0.05,
+             advise_results=None):
     """Load one Table 4 case; return its :class:`BeamCaseResult`. Collective.
 
     Identical on every rank except the point arrays ``points_y``, ``points_p``, ``points_uN``
     (interface quadrature points, sorted by y), present on rank 0 only. Lengths in mm,
     pressures in MPa, forces in N. ``law="auto"``: the law advisor picks the case surface's
-    normal law (cheapest within ``tolerance`` of the full model); its report is printed and
-    written to the case's folder (advice.txt, advice.json).
+    normal law (cheapest within ``tolerance`` of the full model in ``advise_results``, of
+    ``rough_contact.advisor.RESULTS_ALL``, None: all); its report is printed and written to
+    the case's folder (advice.txt, advice.json).
     """
     t0 = MPI.Wtime()
     m00, normal_law = CASES[case]
     if law not in ("table4", "auto"):
         raise ValueError(f"law = {law!r} is invalid; valid values: 'table4', 'auto'")
     if law == "auto":
-        advice, normal = advise_normal_law(comm, m00, hardness, tolerance)
+        advice, normal = advise_normal_law(comm, m00, hardness, tolerance,
+                                           results=advise_results)
         PETSc.Sys.Print(f"\nCase {case}: " + advice.report(), comm=comm)
         if comm.rank == 0:
             case_dir = os.path.join(outdir, f"case{case}")
@@ -597,7 +600,7 @@ def run(cases=tuple(sorted(CASES)), mesh_size=40.0, contact_size=5.0, order=2,
          load_half_length=5.0, steps=16, tangential="mindlin", friction="b", hardness="psi",
          outdir="results/beam", figdir=None, fig_suffix="", prefix="rc_", dof_threshold=None,
          comm=MPI.COMM_WORLD, verbose=True, plot=True, xdmf=True, beam_modulus=E1,
-         overwrite=False, law="table4", tolerance=0.05):
+         overwrite=False, law="table4", tolerance=0.05, advise_results=None):
     """Run the chosen Table 4 cases; return a list of :class:`BeamCaseResult` (same on every
     rank but the rank-0 point arrays).
 
@@ -622,6 +625,8 @@ def run(cases=tuple(sorted(CASES)), mesh_size=40.0, contact_size=5.0, order=2,
             limit, a check of the whole chain against the normal law alone.
         law: "table4" (each case's own normal law) or "auto" (the law advisor's choice
             within ``tolerance`` for each case's surface; the case number then selects m00).
+        advise_results: with law "auto", the FE results the tolerance holds (of
+            ``rough_contact.advisor.RESULTS_ALL``; None: all of them).
 
     Returns:
         list of :class:`BeamCaseResult`, one per case (see :func:`run_case`).
@@ -644,7 +649,7 @@ def run(cases=tuple(sorted(CASES)), mesh_size=40.0, contact_size=5.0, order=2,
     for case in cases:
         results.append(run_case(comm, setup, case, steps, tangential, friction, hardness, outdir,
                                 prefix, dof_threshold, verbose, xdmf, beam_modulus, overwrite,
-                                law, tolerance))
+                                law, tolerance, advise_results))
     text = table(results)
     PETSc.Sys.Print("\n" + text + f"\n\nTotal wall time {MPI.Wtime() - t0:.1f} s on "
                     f"{comm.size} rank(s)", comm=comm)

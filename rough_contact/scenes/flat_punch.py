@@ -376,7 +376,7 @@ def run(mesh_size=20.0, contact_size=2.0, order=2, load_half_width=2.5, steps=16
          unload=True, law="rough", case="b", normal_law="elasto-plastic", outdir="results/flat_punch",
          prefix="rc_", dof_threshold=None, comm=MPI.COMM_WORLD, verbose=True, plot=True,
          overwrite=False, validity="warn", checkpoint=None, restart=None, stop_after=None,
-         tolerance=0.05):
+         tolerance=0.05, advise_results=None):
     """Run the punch; return a :class:`PunchResult` (identical on every rank). Collective.
 
     ``outdir`` receives one run: earlier results there make it refuse unless ``overwrite``.
@@ -389,14 +389,15 @@ def run(mesh_size=20.0, contact_size=2.0, order=2, load_half_width=2.5, steps=16
     increments (checkpoint written), to continue later with ``restart``.
     ``normal_law="auto"`` (or ``law="auto"``): the law advisor picks the cheapest normal law
     within ``tolerance`` of the full model over the run's pressures; its report is printed and
-    written beside the results (advice.txt, advice.json).
+    written beside the results (advice.txt, advice.json). ``advise_results``: the FE results
+    the tolerance holds (of ``rough_contact.advisor.RESULTS_ALL``; None: all of them).
     """
     t0 = MPI.Wtime()
     normal = None
     if law == "auto":
         law, normal_law = "rough", "auto"
     if normal_law == "auto" and law == "rough":
-        advice, normal = advise_law(comm, tolerance, steps)
+        advice, normal = advise_law(comm, tolerance, steps, results=advise_results)
         PETSc.Sys.Print(advice.report(), comm=comm)
         write_advice(comm, advice, outdir)
         normal_law = advice.normal

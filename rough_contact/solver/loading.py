@@ -384,8 +384,12 @@ class _Stepper:
         problem.begin_increment()       # a sliding pairing re-pairs on the committed state
         problem.set_load_factor(lam)
         lam_n, lam_p = self.lam_committed, self.lam_previous
+        reference = None
         if (self.predictor == "secant" and self.u_previous is not None
                 and (lam - lam_n) * (lam_n - lam_p) > 0.0):
+            # the Newton tolerance refers at most to the residual at u_n under the new load, so
+            # the predictor changes the iteration count, not the accuracy of the result
+            reference = self.u_committed
             # u0 = u_n + r (u_n - u_{n-1}), r = (lam - lam_n) / (lam_n - lam_{n-1})
             r = (lam - lam_n) / (lam_n - lam_p)
             u = problem.solution_vector()
@@ -395,7 +399,7 @@ class _Stepper:
             problem.scatter_solution()
             if interface is not None:      # the multipliers of an augmented enforcement too
                 interface.predict(r)
-        ok, result, failure, updates = _solve_step(problem, self.solver, self.comm)
+        ok, result, failure, updates = _solve_step(problem, self.solver, self.comm, reference)
         self.spent[0] += result.iterations
         self.spent[1] += result.linear_iterations
         return ok, result, failure, updates
@@ -535,10 +539,11 @@ def _validity_guard(inc: Increment, policy: str) -> None:
     warnings.warn(msg, ModelValidityWarning, stacklevel=3)
 
 
-def _solve_step(problem: ContactProblem, solver: SNESSolver, comm: MPI.Comm):
+def _solve_step(problem: ContactProblem, solver: SNESSolver, comm: MPI.Comm,
+                reference: Optional[PETSc.Vec] = None):
     """Solve one load step: a Newton solve, then ``interface.accept`` at the converged iterate;
     while an enforcement with multipliers updates them (``Acceptance.done`` False), another
-    Newton solve from the current iterate.
+    Newton solve from the current iterate. ``reference``: see ``SNESSolver.solve``.
 
     Returns:
         (converged, SolveResult with iterations summed over the solves, the failure or None,
@@ -547,7 +552,7 @@ def _solve_step(problem: ContactProblem, solver: SNESSolver, comm: MPI.Comm):
         multipliers, and cuts back).
     """
     interface = problem.interface
-    ok, total, failure = _attempt(solver, comm)
+    ok, total, failure = _attempt(solver, comm, reference=reference)
     updates = 0
     while ok and interface is not None:
         acceptance = interface.accept(problem.u)
@@ -563,21 +568,26 @@ def _solve_step(problem: ContactProblem, solver: SNESSolver, comm: MPI.Comm):
             return False, total, failure, updates
         updates += 1
         first = total.residuals[0] if total.residuals else 0.0
+        if total.reference_norm is not None:
+            first = min(first, total.reference_norm)
         ok, result, failure = _attempt(solver, comm, atol=solver.snes.getTolerances()[0] * first)
         total = SolveResult(result.converged, result.reason, result.reason_name,
                             total.iterations + result.iterations,
                             total.residuals + result.residuals,
-                            total.linear_iterations + result.linear_iterations)
+                            total.linear_iterations + result.linear_iterations,
+                            reference_norm=total.reference_norm)
     return ok, total, failure, updates
 
 
-def _attempt(solver: SNESSolver, comm: MPI.Comm, atol: Optional[float] = None):
-    """One Newton solve (``atol``: see ``SNESSolver.solve``). Returns ``(converged on every
-    rank, SolveResult or None, the ConvergenceError or None)``; every other exception
-    propagates."""
+def _attempt(solver: SNESSolver, comm: MPI.Comm, atol: Optional[float] = None,
+             reference: Optional[PETSc.Vec] = None):
+    """One Newton solve (``atol``, ``reference``: see ``SNESSolver.solve``). Returns
+    ``(converged on every rank, SolveResult or None, the ConvergenceError or None)``; every
+    other exception propagates."""
     failure = None
     try:
-        result = solver.solve() if atol is None else solver.solve(atol=atol)
+        kw = {k: v for k, v in (("atol", atol), ("reference", reference)) if v is not None}
+        result = solver.solve(**kw)
         ok = result.converged
     except ConvergenceError as exc:
         # raised on every rank together by the interface (rough_contact.fem.collective)

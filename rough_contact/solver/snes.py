@@ -183,6 +183,7 @@ class SolveResult:
         linear_iterations: total KSP iterations.
         stages: with a continuation, (softening factor, Newton iterations, converged) of each
             solve in order (factor 1: the law itself); empty without.
+        reference_norm: |F(reference)| of ``SNESSolver.solve(reference=)`` [N], or None.
     """
 
     converged: bool
@@ -192,6 +193,7 @@ class SolveResult:
     residuals: list = field(default_factory=list)
     linear_iterations: int = 0
     stages: list = field(default_factory=list)
+    reference_norm: Optional[float] = None
 
 
 def _reason_name(reason: int) -> str:
@@ -335,6 +337,7 @@ class SNESSolver:
         self._k_norm_inf = problem.K.norm(PETSc.NormType.INFINITY)
         self._set_near_nullspace(near_nullspace)
         self._residuals: list = []
+        self._tighten = None
         self._reported_after_first_solve = False
         self.snes.setMonitor(self._monitor)
 
@@ -359,6 +362,10 @@ class SNESSolver:
 
     def _monitor(self, snes, its, norm):
         self._residuals.append(float(norm))
+        if its == 0 and self._tighten is not None:
+            rtol, atol, ref = self._tighten
+            if norm < ref:      # the start is better than the reference: today's target
+                snes.setTolerances(atol=max(atol, rtol * norm))
 
     @property
     def linear_solver(self) -> str:
@@ -369,7 +376,8 @@ class SNESSolver:
             name += f"({pc.getFactorSolverType()})"
         return name
 
-    def solve(self, atol: Optional[float] = None) -> SolveResult:
+    def solve(self, atol: Optional[float] = None,
+              reference: Optional[PETSc.Vec] = None) -> SolveResult:
         """Solve F(u) = 0 starting from ``problem.u``; on success ``problem.u`` holds the root.
 
         With a :class:`Continuation` and a law that can be softened, a solve that has not
@@ -383,6 +391,13 @@ class SNESSolver:
                 (the augmented-Lagrangian re-solves of a load step use the first solve's
                 rtol x initial residual: a re-solve starts from a small residual, and its
                 own rtol would ask for more accuracy than the step's first solve reached).
+            reference: if given, a state (solution vector) whose residual the relative
+                tolerance refers to at most: the (full-law) solve stops at
+                rtol x min(|F(start)|, |F(reference)|). The load stepping passes the last
+                converged state (evaluated under the new load), so that a predicted start with a
+                larger residual (a secant extrapolation far beyond the last increment, e.g. 400x
+                from the seating step into an exponential law) changes the iteration count, not
+                the accuracy. The norm is in ``SolveResult.reference_norm``.
 
         Raises:
             Exception: whatever a callback raised (the same object, e.g. a ConvergenceError
@@ -392,7 +407,7 @@ class SNESSolver:
         interface = self.problem.interface
         cont = self.continuation
         if cont is None or interface is None or not interface.softenable:
-            return self._solve(atol)
+            return self._solve(atol, reference)
         stages, parts = [], []
         if cont.after is None or cont.after > 0:
             u0 = self.problem.solution_vector().copy()
@@ -400,7 +415,7 @@ class SNESSolver:
             self.snes.setTolerances(max_it=max_it if cont.after is None
                                     else min(cont.after, max_it))
             try:
-                first = self._solve(atol)
+                first = self._solve(atol, reference)
             except ConvergenceError:
                 first = SolveResult(False, 0, "CONVERGENCE_ERROR",
                                     self.snes.getIterationNumber(), [],
@@ -425,22 +440,37 @@ class SNESSolver:
         finally:
             interface.set_softening(1.0)
         if parts[-1].converged:
-            r = self._solve(atol)
+            r = self._solve(atol, reference)
             stages.append((1.0, r.iterations, r.converged))
             parts.append(r)
         last = parts[-1]
         return SolveResult(last.converged, last.reason, last.reason_name,
                            sum(p.iterations for p in parts),
                            [x for p in parts for x in p.residuals],
-                           sum(p.linear_iterations for p in parts), stages)
+                           sum(p.linear_iterations for p in parts), stages,
+                           reference_norm=last.reference_norm)
 
-    def _solve(self, atol: Optional[float]) -> SolveResult:
+    def _residual_norm(self, x: PETSc.Vec) -> float:
+        """|F(x)| under the current load [N] (one residual evaluation; collective). Leaves
+        ``problem.u`` at x."""
+        b = self.problem.b.duplicate()
+        try:
+            self.problem.F(self.snes, x, b)
+            return float(b.norm())
+        finally:
+            b.destroy()
+
+    def _solve(self, atol: Optional[float], reference: Optional[PETSc.Vec] = None) -> SolveResult:
         """One Newton solve of the current law (see :meth:`solve`)."""
         self._residuals = []
         if self.problem.A is not self._A:          # new pattern after a re-pairing
             self.snes.setJacobian(self.problem.J, self.problem.A)
             self._A = self.problem.A
         self.problem.solution_vector().copy(self.x)
+        ref_norm = None
+        if reference is not None:
+            ref_norm = self._residual_norm(reference)
+            self.problem.update_solution(self.x)   # back at the start
         if self.problem.interface is not None:
             self.problem.interface.begin_solve()   # no Newton-step memory from the last solve
         if self._auto_atol:
@@ -455,6 +485,17 @@ class SNESSolver:
             if atol > atol_now:
                 atol_before = atol_now
                 self.snes.setTolerances(atol=atol)
+        # SNES measures rtol against the residual at the start, which a predicted start may have
+        # inflated. With a reference the target is absolute, rtol x |F(reference)|; the monitor
+        # tightens it to rtol x |F(start)| at iteration 0 when the start is the smaller (so the
+        # target is rtol x min of the two; without evaluating the start twice). PETSc >= 3.19
+        # tests iteration 0 before the monitor: a start already within rtol x |F(reference)|
+        # is accepted there, as accurate as a solve from the reference would end.
+        rtol_before, atol_set = self.snes.getTolerances()[:2]
+        self._tighten = None
+        if ref_norm is not None and np.isfinite(ref_norm) and ref_norm > 0.0:
+            self.snes.setTolerances(rtol=0.0, atol=max(atol_set, rtol_before * ref_norm))
+            self._tighten = (rtol_before, atol_set, ref_norm)
         # Some options are read only when the preconditioner is set up, inside the solve.
         self.problem.callback_error = None
         try:
@@ -468,6 +509,9 @@ class SNESSolver:
                 raise self.problem.callback_error from None
             raise
         finally:
+            if self._tighten is not None:
+                self.snes.setTolerances(rtol=rtol_before, atol=atol_set)
+                self._tighten = None
             if atol_before is not None:
                 self.snes.setTolerances(atol=atol_before)
         reason = self.snes.getConvergedReason()
@@ -478,7 +522,7 @@ class SNESSolver:
         res = list(self._residuals)
         ok = reason > 0 and all(np.isfinite(res))
         return SolveResult(ok, int(reason), _reason_name(reason), self.snes.getIterationNumber(),
-                           res, self.snes.getLinearSolveIterations())
+                           res, self.snes.getLinearSolveIterations(), reference_norm=ref_norm)
 
     def _fresh_vectors(self) -> None:
         """After a callback's exception petsc4py >= 3.20 leaves the vectors the line search had

@@ -68,15 +68,22 @@ def test_demo_flat_punch_law_auto(tmp_path, ranks):
     # the demo's asperity data (Y = 2070 MPa, K_Y = 1.62, psi = 0.35) make the e-p law differ
     assert data["normal"] == "elasto-plastic"
     assert f"law=rough ({data['normal']}" in out
+    # the default --results: all four FE results (the punch reports the dissipation)
+    assert data["results"] == ["force", "area", "approach", "dissipation"]
 
 
 def test_demo_beam_law_auto(tmp_path):
     out = run([DEMOS / "demo_beam_rigid_base.py", "--cases", "1", "--mesh-size", "80",
                "--contact-size", "20", "--order", "1", "--steps", "2", "--no-xdmf",
-               "--law", "auto", "--outdir", tmp_path / "beam"], tmp_path)
+               "--law", "auto", "--results", "force", "approach", "--outdir",
+               tmp_path / "beam"], tmp_path)
     assert out.index("Law advice") < out.index("| 1 | 0.625 |")
-    assert (tmp_path / "beam" / "case1" / "advice.txt").read_text().startswith("Law advice")
-    assert (tmp_path / "beam" / "case1" / "advice.json").exists()
+    text = (tmp_path / "beam" / "case1" / "advice.txt").read_text()
+    assert text.startswith("Law advice (tolerance 0.05 on k (force distribution) and the "
+                           "interface approach,"), text
+    import json
+    data = json.loads((tmp_path / "beam" / "case1" / "advice.json").read_text())
+    assert data["results"] == ["force", "approach"]
 
 
 def test_demo_flat_punch_rejects_bad_options(tmp_path):

@@ -259,9 +259,9 @@ class Scene:
         attempts = []
         solve = solver.solve
 
-        def counting_solve():
+        def counting_solve(*args, **kwargs):
             try:
-                res = solve()
+                res = solve(*args, **kwargs)
             except Exception:
                 attempts.append(False)
                 raise

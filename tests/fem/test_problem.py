@@ -354,9 +354,9 @@ def _count_solves(solver):
     calls = []
     solve = solver.solve
 
-    def counting():
+    def counting(*args, **kwargs):
         calls.append(1)
-        return solve()
+        return solve(*args, **kwargs)
 
     solver.solve = counting
     return calls
