@@ -382,10 +382,12 @@ class _Stepper:
         """One attempt at load factor ``lam``: start the increment, predict, solve."""
         problem, interface = self.problem, self.interface
         problem.begin_increment()       # a sliding pairing re-pairs on the committed state
+        held = _loads(problem)
         problem.set_load_factor(lam)
         lam_n, lam_p = self.lam_committed, self.lam_previous
+        # a hold (no channel and no rigid motion changes) starts from the committed state
         if (self.predictor == "secant" and self.u_previous is not None
-                and (lam - lam_n) * (lam_n - lam_p) > 0.0):
+                and (lam - lam_n) * (lam_n - lam_p) > 0.0 and _loads(problem) != held):
             # u0 = u_n + r (u_n - u_{n-1}), r = (lam - lam_n) / (lam_n - lam_{n-1})
             r = (lam - lam_n) / (lam_n - lam_p)
             u = problem.solution_vector()
@@ -477,6 +479,14 @@ class _Stepper:
         return delta, cutbacks
 
 
+def _loads(problem) -> tuple:
+    """What the load factor sets: every channel's scale and a rigid counter-surface's
+    translation (equal tuples: the same loads)."""
+    scales = tuple(sorted(problem.scales.items()))
+    interface = problem.interface
+    return scales + (() if interface is None else tuple(interface.translation.tolist()))
+
+
 def _check_friction_capacity(interface, f, carried, lam, target, lam_committed, why) -> None:
     """Raise FrictionCapacityError if the tangential part of the applied force ``f`` (3,) [N]
     of the failed step exceeds mu_max times the normal force: the larger of the applied one
@@ -548,20 +558,31 @@ def _solve_step(problem: ContactProblem, solver: SNESSolver, comm: MPI.Comm):
     """
     interface = problem.interface
     ok, total, failure = _attempt(solver, comm)
-    updates = 0
+    updates = repairs = 0
     while ok and interface is not None:
         acceptance = interface.accept(problem.u)
         if acceptance.done:
             break
         enforcement = interface.enforcement
-        if updates >= enforcement.max_updates:
+        if acceptance.rebuild:           # large sliding: the new pairing needs new blocks
+            problem.rebuild_matrices()
+        if acceptance.repaired:
+            repairs += 1
+            if repairs > interface.max_repairs:
+                failure = ConvergenceError(
+                    f"large sliding: the pairing still moved by {acceptance.change:.3g} of the "
+                    f"largest facet diameter after {interface.max_repairs} re-pairings "
+                    f"(sliding_tolerance {interface.sliding_tolerance:g}); a smaller increment "
+                    "moves it less")
+                return False, total, failure, updates
+        elif updates >= enforcement.max_updates:
             failure = ConvergenceError(
                 f"augmented Lagrangian: the multipliers still moved by {acceptance.change:.3g} "
                 f"of the largest traction after {updates} updates (augmentation tolerance "
                 f"{enforcement.tolerance:g}, max_updates {enforcement.max_updates}); a stiffer "
                 "penalty needs fewer updates")
             return False, total, failure, updates
-        updates += 1
+        updates += not acceptance.repaired
         first = total.residuals[0] if total.residuals else 0.0
         ok, result, failure = _attempt(solver, comm, atol=solver.snes.getTolerances()[0] * first)
         total = SolveResult(result.converged, result.reason, result.reason_name,

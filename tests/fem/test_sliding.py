@@ -127,8 +127,9 @@ def test_moderate_sliding_refuses_what_it_cannot_do():
     with pytest.raises(ValueError, match="sliding = 'moderate' needs a deformable second"):
         ContactInterface(V, scene.facet_tags, *scene.contact_pair, law=law, sliding="moderate",
                          pairing="mortar")
-    with pytest.raises(ValueError, match="sliding = 'large' is invalid"):
-        ContactInterface(V, scene.facet_tags, *scene.contact_pair, law=law, sliding="large")
+    with pytest.raises(ValueError, match="sliding = 'huge' is invalid: it must be 'small', "
+                       "'moderate' or 'large'"):
+        ContactInterface(V, scene.facet_tags, *scene.contact_pair, law=law, sliding="huge")
 
 
 def test_moderate_sliding_resumes_exactly(tmp_path):
