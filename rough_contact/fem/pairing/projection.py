@@ -21,7 +21,7 @@ from mpi4py import MPI
 from rough_contact.fem.pairing.base import (PairedPoints, Partners, Repaired, SurfaceContext,
                                             first_surface_points, local_frames)
 from rough_contact.fem.pairing.facets import GatheredSurface, cmap_element, facet_set
-from rough_contact.fem.pairing.geometry import project_points, tabulate
+from rough_contact.fem.pairing.geometry import project_points, project_points_from, tabulate
 from rough_contact.validation import check_scalar
 
 __all__ = ["ProjectionPairing", "SlidingProjectionPairing", "facet_areas"]
@@ -184,8 +184,10 @@ class SlidingProjectionPairing(ProjectionPairing):
         cell_x[rows, sec.closure[sec.local_facet]] += u2   # Lagrange: facet = its closure
         nv = sec.vertex_x.shape[1]
         surface = facet_set(ctx.V.mesh, cell_x, sec.local_facet, sec.vertex_x + u2[:, :nv])
-        proj = project_points(x1, paired.frames[:, 0, :], surface, cmap_element(ctx.V.mesh),
-                              self.search_radius)
+        previous = (self._projection.facet if self._projection is not None
+                    else paired.partners.facet.reshape(-1))
+        proj = project_points_from(previous, x1, paired.frames[:, 0, :], surface,
+                                   cmap_element(ctx.V.mesh), self.search_radius)
         self._projection = proj
         return self._repaired(proj, x1, paired.frames[:, 0, :])
 
