@@ -446,7 +446,8 @@ class ContactInterface(InterfaceQueries):
         jump0[~rep.active] = jump_c[~rep.active]
         self._jump0 = jump0
         self._anchor = rep.anchor
-        self.history.pairing = (self.pairing.state(), jump0.copy(), rep.active.copy())
+        self.history.pairing = (self.pairing.state(), jump0.copy(), rep.active.copy(),
+                                None if rep.anchor is None else rep.anchor.copy())
         return changed
 
     def _use(self, rep: Repaired) -> bool:
@@ -588,16 +589,18 @@ class ContactInterface(InterfaceQueries):
         self._forget()
         if not isinstance(self.pairing, SlidingPairing):
             return False
-        self._needs_repair = True      # the next increment re-pairs on the restored state
+        # moderate: the next increment re-pairs on the restored state; large: the restored
+        # pairing is the converged one the interrupted run went on with
+        self._needs_repair = self.sliding != "large"
         if state["pairing"] is None:
             return False
         pairing_state, jump0 = state["pairing"][:2]
         rep = self.pairing.restore(pairing_state)
         if rep is None:
             return False
-        if len(state["pairing"]) > 2:
+        if len(state["pairing"]) > 2:          # (..., active points, anchor points)
             rep = replace(rep, active=np.array(state["pairing"][2], dtype=bool))
         self._use(rep)
         self._jump0 = np.array(jump0)
-        self._anchor = None
+        self._anchor = None if len(state["pairing"]) < 4 else np.array(state["pairing"][3])
         return True

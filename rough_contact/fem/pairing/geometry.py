@@ -136,10 +136,21 @@ def project_points_from(previous: np.ndarray, x: np.ndarray, normal: np.ndarray,
         return project_points(x, normal, surface, cmap, search_radius)
     cand = np.where(previous < surface.size, previous, -1).reshape(n, 1).astype(np.int64)
     result = _candidates(x, normal, surface, cand, cmap, search_radius, inside_tol, max_iter)
-    retry = np.flatnonzero(result.facet < 0)
-    if retry.size:
-        again = project_points(x[retry], normal[retry], surface, cmap, search_radius,
-                               inside_tol=inside_tol, max_iter=max_iter)
+    # points that had no partner (beyond an edge) look among their 4 nearest facets only;
+    # points that left their facet are searched for as at set-up
+    was_off = cand[:, 0] < 0
+    for retry, full in ((np.flatnonzero((result.facet < 0) & was_off), False),
+                        (np.flatnonzero((result.facet < 0) & ~was_off), True)):
+        if retry.size == 0:
+            continue
+        if full:
+            again = project_points(x[retry], normal[retry], surface, cmap, search_radius,
+                                   inside_tol=inside_tol, max_iter=max_iter)
+        else:
+            tree = cKDTree(surface.centroid)
+            again = _candidates(x[retry], normal[retry], surface,
+                                _nearest(tree, x[retry], 4), cmap, search_radius,
+                                inside_tol, max_iter)
         merged = [getattr(result, f).copy() for f in Projection.__dataclass_fields__]
         for arr, new in zip(merged, (getattr(again, f) for f in Projection.__dataclass_fields__)):
             arr[retry] = new
