@@ -217,3 +217,30 @@ def test_points_off_the_slab_are_inactive_by_geometry():
     assert 0 < n_over < ci.n_points_global
     res = ci._result()
     assert np.all(res.traction[~ci.active] == 0.0) and not res.contact[~ci.active].any()
+
+
+def test_sliding_options_refuse_bad_input():
+    from rough_contact.fem.rigid import RigidSphere
+    scene = _scene(MPI.COMM_WORLD, slab_length=4.0)
+    V = compat.vector_space(scene.mesh, 1)
+    law = SoftplusPenalty(1e6, 1e-5)
+    first, second = scene.contact_pair
+    sphere = RigidSphere((0.0, 0.0, -10.0), 10.0)
+    with pytest.raises(ValueError, match="sliding_tolerance = 0.0 is invalid: it must be finite and > 0"):
+        ContactInterface(V, scene.facet_tags, first, second, law=law, sliding="large",
+                         sliding_tolerance=0.0)
+    with pytest.raises(ValueError, match="max_repairs = 0 is invalid: it must be an integer"):
+        ContactInterface(V, scene.facet_tags, first, second, law=law, sliding="large",
+                         max_repairs=0)
+    with pytest.raises(TypeError, match="rigid_motion .* must be a callable"):
+        ContactInterface(V, scene.facet_tags, first, law=law, rigid=sphere,
+                         rigid_motion=(1.0, 0.0, 0.0))
+    with pytest.raises(ValueError, match="rigid_motion moves a rigid counter-surface"):
+        ContactInterface(V, scene.facet_tags, first, second, law=law,
+                         rigid_motion=lambda t: (t, 0.0, 0.0))
+    with pytest.raises(ValueError, match="sliding = 'large' needs a deformable second surface"):
+        ContactInterface(V, scene.facet_tags, first, law=law, sliding="large")
+    ci = ContactInterface(V, scene.facet_tags, first, law=law, rigid=sphere, sliding="large",
+                          rigid_motion=lambda t: (t, 0.0))
+    with pytest.raises(ValueError, match=r"rigid_motion\(0.5\) = \[0.5, 0.0\] is invalid"):
+        ci.set_load_factor(0.5)
