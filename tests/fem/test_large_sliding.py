@@ -244,3 +244,15 @@ def test_sliding_options_refuse_bad_input():
                           rigid_motion=lambda t: (t, 0.0))
     with pytest.raises(ValueError, match=r"rigid_motion\(0.5\) = \[0.5, 0.0\] is invalid"):
         ci.set_load_factor(0.5)
+
+
+def test_points_that_left_arrive_again():
+    """Frictionless slider driven half off the slab's edge and back: the points that left
+    arrive again and the end state is the pressed state (elastic: path-independent)."""
+    out = [(1.0 + 0.1 * (j + 1), 0.2 * (j + 1)) for j in range(5)]
+    back = [(1.5 + 0.1 * (j + 1), 1.0 - 0.2 * (j + 1)) for j in range(5)]
+    r = _run(MPI.COMM_WORLD, "large", out + back, friction=0.0, normal=2e-3,
+             scene_kw=dict(slab_length=2.0))
+    F, n_pts = _forces(r), r["incs"][0].n_points
+    assert min(r["active"]) < n_pts // 2 + n_pts // 10 and r["active"][-1] == n_pts
+    np.testing.assert_allclose(F[-1], F[1], rtol=0, atol=1e-8 * abs(F[1, 2]))

@@ -136,21 +136,24 @@ def project_points_from(previous: np.ndarray, x: np.ndarray, normal: np.ndarray,
         return project_points(x, normal, surface, cmap, search_radius)
     cand = np.where(previous < surface.size, previous, -1).reshape(n, 1).astype(np.int64)
     result = _candidates(x, normal, surface, cand, cmap, search_radius, inside_tol, max_iter)
-    # points that had no partner (beyond an edge) look among their 4 nearest facets only;
-    # points that left their facet are searched for as at set-up
+    # points that left their facet: the facet of the nearest centroid, then a search as at
+    # set-up for those it does not hold; points that had no partner (beyond an edge): their 4
+    # nearest facets only
     was_off = cand[:, 0] < 0
-    for retry, full in ((np.flatnonzero((result.facet < 0) & was_off), False),
-                        (np.flatnonzero((result.facet < 0) & ~was_off), True)):
+    tree = None
+    for group in ("nearest", "off", "full"):
+        missing = result.facet < 0
+        retry = np.flatnonzero(missing & (was_off if group == "off" else ~was_off))
         if retry.size == 0:
             continue
-        if full:
+        if group == "full":
             again = project_points(x[retry], normal[retry], surface, cmap, search_radius,
                                    inside_tol=inside_tol, max_iter=max_iter)
         else:
-            tree = cKDTree(surface.centroid)
+            tree = cKDTree(surface.centroid) if tree is None else tree
             again = _candidates(x[retry], normal[retry], surface,
-                                _nearest(tree, x[retry], 4), cmap, search_radius,
-                                inside_tol, max_iter)
+                                _nearest(tree, x[retry], 1 if group == "nearest" else 4), cmap,
+                                search_radius, inside_tol, max_iter)
         merged = [getattr(result, f).copy() for f in Projection.__dataclass_fields__]
         for arr, new in zip(merged, (getattr(again, f) for f in Projection.__dataclass_fields__)):
             arr[retry] = new
