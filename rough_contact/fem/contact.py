@@ -19,10 +19,13 @@ so the interface terms R_c = int B^T t dA and dR_c/du = int B^T D B dA are assem
 Lifecycle (every call collective; ``docs/design.md`` draws it)::
 
     begin_increment(u)   once per increment: a sliding pairing re-pairs on the committed state
+                         (moderate sliding; large sliding after a revert or a restart)
     predict(ratio)       per attempt: the multipliers' secant predictor (no-op without them)
     evaluate(u)          the law at a trial displacement -> LawResult; always runs the law
     assemble_residual(b) / assemble_jacobian(A)   from the last evaluation
-    accept(u)            a converged iterate: evaluate there, let the enforcement update its
+    accept(u)            a converged iterate: evaluate there; large sliding pairs again there
+                         and, if the pairing moved, installs it -> Acceptance(done=False,
+                         repaired=True, rebuild=...); else the enforcement may update its
                          multipliers -> Acceptance(done=...): solve again unless done
     commit()             the increment is converged: trial -> committed
     revert()             the increment failed: back to the committed state
