@@ -248,9 +248,11 @@ def load_path(problem: ContactProblem, solver: SNESSolver, factors: Iterable[flo
         predictor: initial guess of each Newton solve. ``"secant"`` (default) extrapolates
             linearly in the load factor from the last two converged states,
             u0 = u_n + (lam - lam_n) / (lam_n - lam_{n-1}) (u_n - u_{n-1}), while the load keeps
-            its direction; for the first step and at a load reversal it starts from u_n
-            (retracing the loading path would put every slipping point of a frictional
-            interface on the wrong side of its cone). ``"none"`` always starts from u_n. The
+            its direction; for the first step, at a load reversal and on a hold (no channel
+            scale and no rigid translation changes) it starts from u_n (retracing the loading
+            path would put every slipping point of a frictional interface on the wrong side of
+            its cone; extrapolating a hold moved a held slider's friction force by the Newton
+            tolerance of a far guess). ``"none"`` always starts from u_n. The
             interface history is the committed one either way: the converged result does not
             depend on the choice (to the Newton tolerance), the iteration count does
             (docs/coulomb.md: -67 % / -52 % on the Coulomb punch at mu = 0.2 / 0.5, -19 % on
@@ -550,11 +552,15 @@ def _solve_step(problem: ContactProblem, solver: SNESSolver, comm: MPI.Comm):
     while an enforcement with multipliers updates them (``Acceptance.done`` False), another
     Newton solve from the current iterate.
 
+    A large-sliding interface may re-pair at the converged iterate instead (``Acceptance.
+    repaired``; the matrices are rebuilt when it asks): another Newton solve, at most
+    ``interface.max_repairs`` times.
+
     Returns:
         (converged, SolveResult with iterations summed over the solves, the failure or None,
-        number of multiplier updates). More updates than the enforcement's ``max_updates`` is
-        a failure (a ConvergenceError: the caller reverts, which also restores the
-        multipliers, and cuts back).
+        number of multiplier updates). More updates than the enforcement's ``max_updates``
+        (or re-pairings than ``max_repairs``) is a failure (a ConvergenceError: the caller
+        reverts, which also restores the multipliers, and cuts back).
     """
     interface = problem.interface
     ok, total, failure = _attempt(solver, comm)
