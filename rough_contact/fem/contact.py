@@ -129,7 +129,8 @@ class ContactInterface(InterfaceQueries):
             ``docs/sliding.md``). Moderate and large: the projection pairing, or a rigid
             surface (gap and normal of x + u); a point without partner is inactive.
         rigid_motion: for a rigid counter-surface: its translation [mm] (3,) as a function of
-            the load factor (``ContactProblem.set_load_factor`` passes it on); None: fixed.
+            the load factor (``ContactProblem.set_load_factor`` passes it on; the surface given
+            is where the translation is zero); None: fixed.
         sliding_tolerance: large sliding: the pairing has converged when no partner point (or
             closest point) moved, and no gap changed, by more than this fraction of the
             largest facet diameter of the first surface, > 0.
@@ -192,6 +193,7 @@ class ContactInterface(InterfaceQueries):
                              f"or rigid_plane, not with second_tag = {second_tag!r}")
         self.rigid_motion = rigid_motion
         self._translation = np.zeros(3)
+        self.set_load_factor(0.0)             # the surface where the motion starts it
         self.grain_direction = tuple(float(g) for g in grain)
         self.quadrature, self.quadrature_degree = quadrature, degree
         n_owned = facet_connectivity(V.mesh)

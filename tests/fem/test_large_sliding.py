@@ -240,10 +240,15 @@ def test_sliding_options_refuse_bad_input():
                          rigid_motion=lambda t: (t, 0.0, 0.0))
     with pytest.raises(ValueError, match="sliding = 'large' needs a deformable second surface"):
         ContactInterface(V, scene.facet_tags, first, law=law, sliding="large")
+    with pytest.raises(ValueError, match=r"rigid_motion\(0.0\) = \[0.0, 0.0\] is invalid: it "
+                       "must be 3 finite numbers"):
+        ContactInterface(V, scene.facet_tags, first, law=law, rigid=sphere, sliding="large",
+                         rigid_motion=lambda t: (t, 0.0))
     ci = ContactInterface(V, scene.facet_tags, first, law=law, rigid=sphere, sliding="large",
-                          rigid_motion=lambda t: (t, 0.0))
-    with pytest.raises(ValueError, match=r"rigid_motion\(0.5\) = \[0.5, 0.0\] is invalid"):
-        ci.set_load_factor(0.5)
+                          rigid_motion=lambda t: (t, 0.0, 1.0 if t < 1.0 else np.inf))
+    assert ci.translation.tolist() == [0.0, 0.0, 1.0]      # where the motion starts
+    with pytest.raises(ValueError, match=r"rigid_motion\(1.0\) = \[1.0, 0.0, inf\] is invalid"):
+        ci.set_load_factor(1.0)
 
 
 def test_points_that_left_arrive_again():
