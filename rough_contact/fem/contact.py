@@ -19,10 +19,13 @@ so the interface terms R_c = int B^T t dA and dR_c/du = int B^T D B dA are assem
 Lifecycle (every call collective; ``docs/design.md`` draws it)::
 
     begin_increment(u)   once per increment: a sliding pairing re-pairs on the committed state
+                         (moderate sliding; large sliding after a revert or a restart)
     predict(ratio)       per attempt: the multipliers' secant predictor (no-op without them)
     evaluate(u)          the law at a trial displacement -> LawResult; always runs the law
     assemble_residual(b) / assemble_jacobian(A)   from the last evaluation
-    accept(u)            a converged iterate: evaluate there, let the enforcement update its
+    accept(u)            a converged iterate: evaluate there; large sliding pairs again there
+                         and, if the pairing moved, installs it -> Acceptance(done=False,
+                         repaired=True, rebuild=...); else the enforcement may update its
                          multipliers -> Acceptance(done=...): solve again unless done
     commit()             the increment is converged: trial -> committed
     revert()             the increment failed: back to the committed state
@@ -43,7 +46,7 @@ Units: mm, N, MPa.
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
-from typing import Optional, Sequence, Union
+from typing import Callable, Optional, Sequence, Union
 
 import numpy as np
 from mpi4py import MPI
@@ -57,6 +60,7 @@ from rough_contact.fem.interface_setup import (RigidPlane, check_arguments, chec
 from rough_contact.fem.jump import JumpOperator
 from rough_contact.fingerprint import describe
 from rough_contact.fem.pairing import Pairing, SlidingPairing, SurfaceContext
+from rough_contact.fem.pairing.base import Repaired
 from rough_contact.fem.pairing.facets import (FacetGeometry, FacetRule, facet_connectivity,
                                               owned_tagged_facets)
 from rough_contact.fem.queries import InterfaceQueries, InterfaceSummary, PointFields
@@ -64,7 +68,7 @@ from rough_contact.fem.rigid import RigidSurface
 from rough_contact.interface.contract import (ConvergenceError, InterfaceLawProtocol, LawResult,
                                               NewtonTangentLaw, SoftenableLaw)
 from rough_contact.interface.enforcement import AugmentedLagrangian, Enforcement, Penalty
-from rough_contact.interface.state import InterfaceHistory
+from rough_contact.interface.state import InterfaceHistory, keep_points
 from rough_contact.validation import check_scalar
 
 __all__ = ["ContactInterface", "InterfaceSummary", "PointFields", "Acceptance"]
@@ -75,13 +79,20 @@ class Acceptance:
     """What :meth:`ContactInterface.accept` decided about a converged iterate.
 
     Attributes:
-        done: the increment can be committed (False: the multipliers were updated, solve again).
+        done: the increment can be committed (False: the multipliers were updated, or the
+            pairing moved (large sliding): solve again).
         change: the largest multiplier change relative to the largest traction [-] (0 for a
-            penalty enforcement).
+            penalty enforcement); after a re-pairing, how far the pairing moved relative to the
+            largest facet diameter of the first surface [-].
+        repaired: the pairing was updated on the converged iterate (large sliding).
+        rebuild: the new pairing needs matrix entries the current pattern lacks (the problem
+            rebuilds its matrices before solving again).
     """
 
     done: bool
     change: float = 0.0
+    repaired: bool = False
+    rebuild: bool = False
 
 
 class ContactInterface(InterfaceQueries):
@@ -111,8 +122,20 @@ class ContactInterface(InterfaceQueries):
             :class:`~rough_contact.fem.pairing.Pairing` object, e.g.
             ``AutoPairing(second_tag, "mortar")`` (conforming, else mortar).
         search_radius: projection/mortar: largest accepted normal distance to a partner [mm].
-        sliding: ``"small"`` (partners found once) or ``"moderate"`` (the projection redone on
-            the deformed surfaces at the start of every increment: ``begin_increment``).
+        sliding: ``"small"`` (partners found once, a rigid gap linearised at set-up),
+            ``"moderate"`` (the pairing redone on the deformed configuration at the start of
+            every increment: ``begin_increment``) or ``"large"`` (moreover redone on every
+            converged iterate until it stops moving: a fixed point per increment, see
+            ``docs/sliding.md``). Moderate and large: the projection pairing, or a rigid
+            surface (gap and normal of x + u); a point without partner is inactive.
+        rigid_motion: for a rigid counter-surface: its translation [mm] (3,) as a function of
+            the load factor (``ContactProblem.set_load_factor`` passes it on; the surface given
+            is where the translation is zero); None: fixed.
+        sliding_tolerance: large sliding: the pairing has converged when no partner point (or
+            closest point) moved, and no gap changed, by more than this fraction of the
+            largest facet diameter of the first surface, > 0.
+        max_repairs: large sliding: re-pairings per increment (>= 1) before the increment
+            counts as failed (cutback).
         enforcement: :class:`~rough_contact.interface.enforcement.Penalty` (default: the law
             as it is) or :class:`~rough_contact.interface.enforcement.AugmentedLagrangian`.
 
@@ -141,7 +164,9 @@ class ContactInterface(InterfaceQueries):
                  quadrature_degree: int = 2, quadrature: str = "gauss", bcs: Sequence = (),
                  match_tolerance: float = 1e-6, pairing: Union[str, Pairing] = "auto",
                  search_radius: Optional[float] = None, sliding: str = "small",
-                 enforcement: Optional[Enforcement] = None):
+                 enforcement: Optional[Enforcement] = None,
+                 rigid_motion: Optional[Callable[[float], Sequence[float]]] = None,
+                 sliding_tolerance: float = 1e-10, max_repairs: int = 20):
         self.comm, self.V, self.law = V.mesh.comm, V, law
         self.enforcement = Penalty() if enforcement is None else enforcement
         if not isinstance(self.enforcement, Enforcement):
@@ -154,6 +179,21 @@ class ContactInterface(InterfaceQueries):
                                         quadrature_degree, grain_direction, quadrature)
         self.enforcement.check_law(law)
         self.first_tag, self.second_tag, self.sliding = first_tag, second_tag, sliding
+        self.sliding_tolerance = check_scalar("sliding_tolerance", sliding_tolerance, lo=0.0)
+        if (not isinstance(max_repairs, (int, np.integer)) or isinstance(max_repairs, bool)
+                or max_repairs < 1):
+            raise ValueError(f"max_repairs = {max_repairs!r} is invalid: it must be an integer "
+                             ">= 1")
+        self.max_repairs = int(max_repairs)
+        if rigid_motion is not None and not callable(rigid_motion):
+            raise TypeError(f"rigid_motion ({type(rigid_motion).__name__}) must be a callable "
+                            "load factor -> translation (3,) [mm]")
+        if rigid_motion is not None and second_tag is not None:
+            raise ValueError("rigid_motion moves a rigid counter-surface: give it with rigid "
+                             f"or rigid_plane, not with second_tag = {second_tag!r}")
+        self.rigid_motion = rigid_motion
+        self._translation = np.zeros(3)
+        self.set_load_factor(0.0)             # the surface where the motion starts it
         self.grain_direction = tuple(float(g) for g in grain)
         self.quadrature, self.quadrature_degree = quadrature, degree
         n_owned = facet_connectivity(V.mesh)
@@ -171,6 +211,13 @@ class ContactInterface(InterfaceQueries):
             self.pairing, self.paired = chosen, chosen.pair(ctx)
         self.pairing_used = self.paired.name
         self.n_repairs, self._needs_repair, self._matrix_keys = 0, False, set()
+        self.n_fixed_point = 0       # large sliding: re-pairings on converged iterates, in all
+        vx1 = ctx.geo1.vertex_x
+        diam = (np.linalg.norm(vx1[:, :, None] - vx1[:, None], axis=-1).max(initial=0.0)
+                if vx1.shape[0] else 0.0)
+        self._length = self.comm.allreduce(float(diam), op=MPI.MAX)
+        self._active = np.ones(self.paired.n_points, dtype=bool)
+        self._anchor = self._start = None
         self._dirichlet = (None, list(bcs))
         self._set_operator(JumpOperator(V, self.paired, bcs=bcs))
         n = self.n_points
@@ -211,8 +258,32 @@ class ContactInterface(InterfaceQueries):
 
     def jump(self, u) -> np.ndarray:
         """Local jump [g, s_x, s_y] (n_pts, 3) [mm] at displacement u (Function or PETSc Vec)."""
+        return self._raw(u, self._translation) + self._jump0
+
+    def _raw(self, u, translation: np.ndarray) -> np.ndarray:
+        """B u, plus the rigid counter-surface's translation seen in the local frames (it is
+        the second surface's displacement) [mm]."""
         x = u if isinstance(u, PETSc.Vec) else compat.petsc_vector(u)
-        return self.operator.apply(self.operator.pair_values(x)) + self._jump0
+        raw = self.operator.apply(self.operator.pair_values(x))
+        if self.paired.partners is None and np.any(translation != 0.0):
+            raw = raw + np.einsum("pai,i->pa", self.paired.frames, translation)
+        return raw
+
+    def set_load_factor(self, lam: float) -> None:
+        """Move a rigid counter-surface to ``rigid_motion(lam)`` (no communication; no-op
+        without a motion). ``ContactProblem.set_load_factor`` calls it."""
+        if self.rigid_motion is None:
+            return
+        d = np.asarray(self.rigid_motion(float(lam)), dtype=float)
+        if d.shape != (3,) or not np.all(np.isfinite(d)):
+            raise ValueError(f"rigid_motion({float(lam)!r}) = {d.tolist()!r} is invalid: it "
+                             "must be 3 finite numbers (a translation in mm)")
+        self._translation = d
+
+    @property
+    def translation(self) -> np.ndarray:
+        """(3,) current translation of a rigid counter-surface [mm] (zero without motion)."""
+        return self._translation.copy()
 
     # ------------------------------------------------------------------ lifecycle
     def evaluate(self, u) -> LawResult:
@@ -240,9 +311,41 @@ class ContactInterface(InterfaceQueries):
             error = exc
         raise_on_all_ranks(self.comm, error)
         self._result_checked = True
+        if not self._active.all():
+            res = self._without_inactive(res)
         self.history.law.update(res)
         self._last, self._last_jump = res, jump
         return res
+
+    def _without_inactive(self, res: LawResult) -> LawResult:
+        """``res`` with the points without partner made inactive: zero traction, tangent and
+        dissipation, not in contact, their history frozen at the committed state."""
+        off = ~self._active
+        traction, tangent = res.traction.copy(), res.tangent.copy()
+        traction[off], tangent[off] = 0.0, 0.0
+
+        def zero(a, value):
+            if a is None:
+                return None
+            a = a.copy()
+            a[off] = value
+            return a
+
+        return replace(res, traction=traction, tangent=tangent,
+                       state=keep_points(res.state, self.history.law.committed, off),
+                       dissipation=zero(res.dissipation, 0.0),
+                       area_fraction=zero(res.area_fraction, 0.0),
+                       contact=zero(res.contact, False), slipping=zero(res.slipping, False),
+                       beyond_validity=zero(res.beyond_validity, False),
+                       normal_dissipation=zero(res.normal_dissipation, 0.0))
+
+    @property
+    def active(self) -> np.ndarray:
+        """(n_pts,) bool: the point has a partner (False: it slid off the second surface or
+        separated beyond the search radius; zero traction) (read-only)."""
+        a = self._active.view()
+        a.flags.writeable = False
+        return a
 
     def _evaluating_law(self) -> InterfaceLawProtocol:
         law = self.law if self._softened is None else self._softened[1]
@@ -311,38 +414,104 @@ class ContactInterface(InterfaceQueries):
         self._newton_memo = None
 
     def begin_increment(self, u) -> bool:
-        """Start an increment (collective): a sliding pairing projects the points again on the
-        committed deformed surfaces (after the previous increment was reported and
-        checkpointed). Returns True when the matrix pattern must be rebuilt
+        """Start an increment at the committed displacement u (collective): a sliding pairing
+        pairs again on the committed configuration (after the previous increment was reported
+        and checkpointed). Returns True when the matrix pattern must be rebuilt
         (``ContactProblem.begin_increment`` does it)."""
-        if not (self._needs_repair and isinstance(self.pairing, SlidingPairing)):
+        if not isinstance(self.pairing, SlidingPairing):
+            return False
+        x = compat.petsc_vector(u)
+        # what the re-pairings of this increment start from (the committed configuration)
+        self._start = (self.jump(u), x.copy(), self._translation.copy(), self._active.copy(),
+                       np.array(self.history.law.committed.plastic_slip))
+        if not self._needs_repair:
             return False
         self._needs_repair = False
-        jump_old = self.jump(u)
-        partners, distance = self.pairing.repair(compat.function_values(u).reshape(-1, 3),
-                                                 self.paired)
-        changed = self._use_partners(partners)
-        raw = self.jump(u) - self._jump0
-        jump0 = jump_old - raw                     # tangential jump continuous
-        jump0[:, 0] = distance - raw[:, 0]         # normal: the geometric gap now
+        return self._install(self._repair(u), u)
+
+    def _repair(self, u) -> Repaired:
+        return self.pairing.repair(compat.function_values(u).reshape(-1, 3), self.paired,
+                                   self._translation)
+
+    def _install(self, rep: Repaired, u) -> bool:
+        """Use the pairing ``rep`` found at displacement u (collective). The jump offsets: the
+        tangential jump is continuous at the committed configuration (the elastic slip carried
+        over; a point that arrives starts with none: s = s_p there), the normal gap is the
+        re-pairing's (exact at u); a point without partner keeps its committed jump, unused.
+        Returns True when the matrix pattern must be rebuilt."""
+        jump_c, x_c, d_c, active_c, slip_c = self._start
+        changed = self._use(rep)
+        raw_c = self._raw(x_c, d_c)
+        raw_k = self._raw(u, self._translation)
+        jump0 = np.empty_like(raw_c)
+        jump0[:, 1:] = jump_c[:, 1:] - raw_c[:, 1:]
+        arriving = rep.active & ~active_c
+        jump0[arriving, 1:] = slip_c[arriving] - raw_c[arriving, 1:]
+        jump0[:, 0] = rep.gap - raw_k[:, 0]
+        jump0[~rep.active] = jump_c[~rep.active]
         self._jump0 = jump0
-        self.history.pairing = (self.pairing.state(), jump0.copy())
+        self._anchor = rep.anchor
+        self.history.pairing = (self.pairing.state(), jump0.copy(), rep.active.copy(),
+                                None if rep.anchor is None else rep.anchor.copy())
         return changed
 
-    def _use_partners(self, partners) -> bool:
-        before = self.paired.partners.facet.reshape(-1)
-        moved = self.comm.allreduce(int(np.any(partners.facet.reshape(-1) != before)),
-                                    op=MPI.SUM)
-        self.paired = replace(self.paired, partners=partners)
+    def _use(self, rep: Repaired) -> bool:
+        """Rebuild the jump operator on the pairing ``rep`` (zero offsets; collective).
+        Returns True when the matrix pattern must be rebuilt."""
+        partners = rep.partners
+        if partners is not None:
+            before = self.paired.partners.facet.reshape(-1)
+            moved = int(np.any(partners.facet.reshape(-1) != before))
+        else:
+            moved = int(rep.frames is not None and not np.array_equal(rep.frames,
+                                                                       self.paired.frames))
+        moved = self.comm.allreduce(moved, op=MPI.SUM)
+        frames = self.paired.frames if rep.frames is None else rep.frames
+        self.paired = replace(self.paired, partners=partners, frames=frames)
+        self._active = np.asarray(rep.active, dtype=bool).copy()
+        on_operator = self.paired
+        if not self._active.all():           # points without partner: B = 0
+            n_f, nq = self.paired.N1.shape[:2]
+            N1 = self.paired.N1 * self._active.reshape(n_f, nq)[..., None]
+            on_operator = replace(self.paired, N1=N1)
         global_dofs, bcs = self._dirichlet
-        self._set_operator(JumpOperator(self.V, self.paired, bcs=bcs, global_dofs=global_dofs),
+        self._set_operator(JumpOperator(self.V, on_operator, bcs=bcs, global_dofs=global_dofs),
                            jump0=np.zeros((self.n_points, 3)))
         self._last = None
         self.n_repairs += bool(moved)
+        if self.keys is None:                # a rigid surface: blocks are the facets
+            return False
         # the pattern follows the current blocks exactly (not their history): a resumed run
         # assembles into the same pattern as the uninterrupted one, bit for bit
         changed = {tuple(k) for k in self.keys.tolist()} != self._matrix_keys
         return bool(self.comm.allreduce(changed, op=MPI.LOR))
+
+    def _follow(self, u) -> Optional[Acceptance]:
+        """Large sliding: pair again at the converged iterate u (collective). None if the
+        pairing did not move (the same points active, no partner point and no gap moved by
+        more than ``sliding_tolerance`` x the largest facet diameter); else the new pairing is
+        installed and the increment must be solved again."""
+        rep = self._repair(u)
+        act = rep.active
+        moved = np.zeros(2)
+        moved[0] = float(np.any(act != self._active))
+        if act.any():
+            gap_now = self._last_jump[act, 0]
+            shift = np.abs(rep.gap[act] - gap_now).max()
+            if self._anchor is not None:
+                shift = max(shift, np.linalg.norm(rep.anchor[act] - self._anchor[act],
+                                                  axis=1).max())
+            else:
+                shift = np.inf
+            moved[1] = shift
+        self.comm.Allreduce(MPI.IN_PLACE, moved, op=MPI.MAX)
+        rel = moved[1] / self._length if self._length > 0 else moved[1]
+        if moved[0] == 0.0 and rel <= self.sliding_tolerance:
+            return None
+        rebuild = self._install(rep, u)
+        self.n_fixed_point += 1
+        self._forget()
+        return Acceptance(False, float(rel), repaired=True, rebuild=rebuild)
 
     def predict(self, ratio: float) -> bool:
         """Secant predictor of the multipliers, lambda_n + ratio (lambda_n - lambda_{n-1})
@@ -361,6 +530,10 @@ class ContactInterface(InterfaceQueries):
         change over all points and ranks / largest traction magnitude), they replace the
         committed ones and the increment must be solved again (``done`` False)."""
         res = self.evaluate(u)
+        if self.sliding == "large":
+            moved = self._follow(u)
+            if moved is not None:
+                return moved
         if not isinstance(self.enforcement, AugmentedLagrangian):
             return Acceptance(True)
         update = self.enforcement.update(self.history.multipliers, res)
@@ -379,13 +552,17 @@ class ContactInterface(InterfaceQueries):
     def commit(self) -> None:
         """Accept the trial state of the last evaluation (after :meth:`accept` said done)."""
         self.history.commit()
-        self._needs_repair = True
+        # moderate sliding pairs again at the next increment's start; large sliding ends every
+        # increment on a converged pairing, which the next one starts from
+        self._needs_repair = self.sliding != "large"
         self._newton_memo = None
 
     def revert(self) -> None:
         """Back to the committed state (failed increment, before a cutback)."""
         self.history.revert()
         self._forget()
+        if self.sliding == "large":         # the next attempt pairs on the committed state
+            self._needs_repair = True
 
     def _forget(self) -> None:
         self._last = None
@@ -417,13 +594,18 @@ class ContactInterface(InterfaceQueries):
         self._forget()
         if not isinstance(self.pairing, SlidingPairing):
             return False
-        self._needs_repair = True      # the next increment re-pairs on the restored state
+        # moderate: the next increment re-pairs on the restored state; large: the restored
+        # pairing is the converged one the interrupted run went on with
+        self._needs_repair = self.sliding != "large"
         if state["pairing"] is None:
             return False
-        pairing_state, jump0 = state["pairing"]
-        partners = self.pairing.restore(pairing_state)
-        if partners is None:
+        pairing_state, jump0 = state["pairing"][:2]
+        rep = self.pairing.restore(pairing_state)
+        if rep is None:
             return False
-        self._use_partners(partners)
+        if len(state["pairing"]) > 2:          # (..., active points, anchor points)
+            rep = replace(rep, active=np.array(state["pairing"][2], dtype=bool))
+        self._use(rep)
         self._jump0 = np.array(jump0)
+        self._anchor = None if len(state["pairing"]) < 4 else np.array(state["pairing"][3])
         return True

@@ -20,6 +20,7 @@ from rough_contact.fem.pairing import (ConformingPairing, MortarPairing, Pairing
                                        ProjectionPairing, RigidPairing,
                                        SlidingProjectionPairing)
 from rough_contact.fem.pairing.auto import AutoPairing
+from rough_contact.fem.pairing.rigid import SlidingRigidPairing
 from rough_contact.fem.pairing.facets import CELLS
 from rough_contact.fem.rigid import RigidPlane as RigidPlaneSurface
 from rough_contact.fem.rigid import RigidSurface
@@ -33,6 +34,7 @@ __all__ = ["check_arguments", "select_pairing", "initial_law_state", "check_resu
 
 RigidPlane = Tuple[Sequence[float], Sequence[float]]  # (point (3,), unit normal (3,)) [mm]
 PAIRINGS = ("auto", "conforming", "projection", "mortar")
+SLIDING = ("small", "moderate", "large")
 
 
 def check_arguments(V, law, first_tag, second_tag, rigid_plane, quadrature_degree,
@@ -86,8 +88,9 @@ def select_pairing(V, pairing: Union[str, Pairing], second_tag: Optional[int],
     check_scalar("match_tolerance", match_tolerance, lo=0.0)
     if search_radius is not None:
         check_scalar("search_radius", search_radius, lo=0.0, unit="mm")
-    if sliding not in ("small", "moderate"):
-        raise ValueError(f"sliding = {sliding!r} is invalid: it must be 'small' or 'moderate'")
+    if sliding not in SLIDING:
+        raise ValueError(f"sliding = {sliding!r} is invalid: it must be 'small', 'moderate' or "
+                         "'large'")
     if not isinstance(pairing, str):
         if not isinstance(pairing, Pairing):
             raise TypeError(f"pairing ({type(pairing).__name__}) must be one of {PAIRINGS} or "
@@ -104,25 +107,25 @@ def select_pairing(V, pairing: Union[str, Pairing], second_tag: Optional[int],
         if rigid_plane is not None:
             _plane(rigid_plane)                         # validates with its own message
             rigid = RigidPlaneSurface(*rigid_plane)     # normalises once
-        if sliding == "moderate":
-            raise ValueError(
-                f"sliding = 'moderate' needs a deformable second surface (second_tag) and "
-                f"the projection pairing (pairing 'auto' or 'projection', got {pairing!r}, "
-                f"second_tag {second_tag!r})")
         if pairing == "mortar":
             raise ValueError("pairing = 'mortar' needs a second surface (second_tag) and "
                              "the Gauss rule (quadrature='gauss')")
+        if sliding != "small":
+            if rigid is None:
+                raise ValueError(
+                    f"sliding = {sliding!r} needs a deformable second surface (second_tag) "
+                    "and the projection pairing, or a rigid surface (rigid or rigid_plane); "
+                    "the tangent plane of a rigid obstacle given by neither cannot slide")
+            _same_degree(V, sliding)
+            return SlidingRigidPairing(rigid)
         return RigidPairing(rigid)
-    if sliding == "moderate":
+    if sliding != "small":
         if pairing not in ("auto", "projection"):
             raise ValueError(
-                f"sliding = 'moderate' needs a deformable second surface (second_tag) and "
+                f"sliding = {sliding!r} needs a deformable second surface (second_tag) and "
                 f"the projection pairing (pairing 'auto' or 'projection', got {pairing!r}, "
                 f"second_tag {second_tag!r})")
-        if compat.element_degree(V) != compat.geometry_degree(V.mesh):
-            raise ValueError(
-                f"sliding = 'moderate' needs a displacement space of the geometry's degree "
-                f"({compat.geometry_degree(V.mesh)}), got {compat.element_degree(V)}")
+        _same_degree(V, sliding)
         return SlidingProjectionPairing(second_tag, search_radius)
     if pairing == "mortar":
         if quadrature != "gauss":
@@ -134,6 +137,13 @@ def select_pairing(V, pairing: Union[str, Pairing], second_tag: Optional[int],
     if pairing == "conforming":
         return ConformingPairing(second_tag, match_tolerance)
     return "auto"
+
+
+def _same_degree(V, sliding: str) -> None:
+    if compat.element_degree(V) != compat.geometry_degree(V.mesh):
+        raise ValueError(
+            f"sliding = {sliding!r} needs a displacement space of the geometry's degree "
+            f"({compat.geometry_degree(V.mesh)}), got {compat.element_degree(V)}")
 
 
 def pair_auto(ctx, second_tag, match_tolerance, search_radius):

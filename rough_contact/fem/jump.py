@@ -78,7 +78,9 @@ class JumpOperator:
             own_slot = np.ones(n_f * nq, dtype=bool)
         else:
             if partners.facet.size:
-                key = np.arange(n_f)[:, None] * (int(partners.facet.max()) + 1) + partners.facet
+                # partner facet -1: a point without partner (sliding), a group of its own
+                key = (np.arange(n_f)[:, None] * (int(partners.facet.max()) + 2)
+                       + partners.facet + 1)
             else:
                 key = np.zeros((0, nq), dtype=np.int64)
             copy_of = (np.full(n_f * nq, -1, dtype=np.int64) if partners.copy_of is None

@@ -544,6 +544,8 @@ class ContactProblem:
         times their nominal value (the lifting is recomputed when displacements are
         prescribed)."""
         self.load_factor = check_scalar("load factor", lam)
+        if self.interface is not None:      # a rigid counter-surface may move with it
+            self.interface.set_load_factor(self.load_factor)
         for name in self.scales:
             fn = self.programs.get(name)
             self.scales[name] = self.load_factor if fn is None else check_scalar(

@@ -19,7 +19,7 @@ import numpy as np
 from .contract import LawResult, LawState
 
 __all__ = ["InterfaceState", "HistoryInterfaceState", "StatePair", "InterfaceHistory",
-           "is_pointwise", "take_points"]
+           "is_pointwise", "take_points", "keep_points"]
 
 
 @dataclass
@@ -311,3 +311,22 @@ def take_points(states: Sequence[LawState], index: np.ndarray) -> LawState:
     joined = {f.name: np.concatenate([getattr(s, f.name) for s in states], axis=0)[index]
               for f in dataclasses.fields(first)}
     return dataclasses.replace(first, **joined)
+
+
+def keep_points(trial: LawState, committed: LawState, keep: np.ndarray) -> LawState:
+    """``trial`` with the points ``keep`` (n,) bool taken from ``committed`` instead (their
+    history frozen, e.g. interface points that lost their partner).
+
+    Raises:
+        TypeError: the states are not :func:`is_pointwise` or not of one type.
+    """
+    if type(trial) is not type(committed) or not is_pointwise(trial) \
+            or not is_pointwise(committed):
+        raise TypeError(f"law states of type {type(trial).__name__} / "
+                        f"{type(committed).__name__} cannot be frozen point by point (a "
+                        "dataclass of batch-first ndarray fields, both of one type, is needed)")
+    keep = np.asarray(keep, dtype=bool)
+    out = trial.copy()
+    for f in dataclasses.fields(out):
+        getattr(out, f.name)[keep] = getattr(committed, f.name)[keep]
+    return out

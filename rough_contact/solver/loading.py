@@ -248,9 +248,11 @@ def load_path(problem: ContactProblem, solver: SNESSolver, factors: Iterable[flo
         predictor: initial guess of each Newton solve. ``"secant"`` (default) extrapolates
             linearly in the load factor from the last two converged states,
             u0 = u_n + (lam - lam_n) / (lam_n - lam_{n-1}) (u_n - u_{n-1}), while the load keeps
-            its direction; for the first step and at a load reversal it starts from u_n
-            (retracing the loading path would put every slipping point of a frictional
-            interface on the wrong side of its cone). ``"none"`` always starts from u_n. The
+            its direction; for the first step, at a load reversal and on a hold (no channel
+            scale and no rigid translation changes) it starts from u_n (retracing the loading
+            path would put every slipping point of a frictional interface on the wrong side of
+            its cone; extrapolating a hold moved a held slider's friction force by the Newton
+            tolerance of a far guess). ``"none"`` always starts from u_n. The
             interface history is the committed one either way: the converged result does not
             depend on the choice (to the Newton tolerance), the iteration count does
             (docs/coulomb.md: -67 % / -52 % on the Coulomb punch at mu = 0.2 / 0.5, -19 % on
@@ -382,11 +384,13 @@ class _Stepper:
         """One attempt at load factor ``lam``: start the increment, predict, solve."""
         problem, interface = self.problem, self.interface
         problem.begin_increment()       # a sliding pairing re-pairs on the committed state
+        held = _loads(problem)
         problem.set_load_factor(lam)
         lam_n, lam_p = self.lam_committed, self.lam_previous
         reference = None
+        # a hold (no channel and no rigid motion changes) starts from the committed state
         if (self.predictor == "secant" and self.u_previous is not None
-                and (lam - lam_n) * (lam_n - lam_p) > 0.0):
+                and (lam - lam_n) * (lam_n - lam_p) > 0.0 and _loads(problem) != held):
             # the Newton tolerance refers at most to the residual at u_n under the new load, so
             # the predictor changes the iteration count, not the accuracy of the result
             reference = self.u_committed
@@ -481,6 +485,14 @@ class _Stepper:
         return delta, cutbacks
 
 
+def _loads(problem) -> tuple:
+    """What the load factor sets: every channel's scale and a rigid counter-surface's
+    translation (equal tuples: the same loads)."""
+    scales = tuple(sorted(problem.scales.items()))
+    interface = problem.interface
+    return scales + (() if interface is None else tuple(interface.translation.tolist()))
+
+
 def _check_friction_capacity(interface, f, carried, lam, target, lam_committed, why) -> None:
     """Raise FrictionCapacityError if the tangential part of the applied force ``f`` (3,) [N]
     of the failed step exceeds mu_max times the normal force: the larger of the applied one
@@ -545,28 +557,43 @@ def _solve_step(problem: ContactProblem, solver: SNESSolver, comm: MPI.Comm,
     while an enforcement with multipliers updates them (``Acceptance.done`` False), another
     Newton solve from the current iterate. ``reference``: see ``SNESSolver.solve``.
 
+    A large-sliding interface may re-pair at the converged iterate instead (``Acceptance.
+    repaired``; the matrices are rebuilt when it asks): another Newton solve, at most
+    ``interface.max_repairs`` times.
+
     Returns:
         (converged, SolveResult with iterations summed over the solves, the failure or None,
-        number of multiplier updates). More updates than the enforcement's ``max_updates`` is
-        a failure (a ConvergenceError: the caller reverts, which also restores the
-        multipliers, and cuts back).
+        number of multiplier updates). More updates than the enforcement's ``max_updates``
+        (or re-pairings than ``max_repairs``) is a failure (a ConvergenceError: the caller
+        reverts, which also restores the multipliers, and cuts back).
     """
     interface = problem.interface
     ok, total, failure = _attempt(solver, comm, reference=reference)
-    updates = 0
+    updates = repairs = 0
     while ok and interface is not None:
         acceptance = interface.accept(problem.u)
         if acceptance.done:
             break
         enforcement = interface.enforcement
-        if updates >= enforcement.max_updates:
+        if acceptance.rebuild:           # large sliding: the new pairing needs new blocks
+            problem.rebuild_matrices()
+        if acceptance.repaired:
+            repairs += 1
+            if repairs > interface.max_repairs:
+                failure = ConvergenceError(
+                    f"large sliding: the pairing still moved by {acceptance.change:.3g} of the "
+                    f"largest facet diameter after {interface.max_repairs} re-pairings "
+                    f"(sliding_tolerance {interface.sliding_tolerance:g}); a smaller increment "
+                    "moves it less")
+                return False, total, failure, updates
+        elif updates >= enforcement.max_updates:
             failure = ConvergenceError(
                 f"augmented Lagrangian: the multipliers still moved by {acceptance.change:.3g} "
                 f"of the largest traction after {updates} updates (augmentation tolerance "
                 f"{enforcement.tolerance:g}, max_updates {enforcement.max_updates}); a stiffer "
                 "penalty needs fewer updates")
             return False, total, failure, updates
-        updates += 1
+        updates += not acceptance.repaired
         first = total.residuals[0] if total.residuals else 0.0
         if total.reference_norm is not None:
             first = min(first, total.reference_norm)

@@ -127,19 +127,21 @@ def test_moderate_sliding_refuses_what_it_cannot_do():
     with pytest.raises(ValueError, match="sliding = 'moderate' needs a deformable second"):
         ContactInterface(V, scene.facet_tags, *scene.contact_pair, law=law, sliding="moderate",
                          pairing="mortar")
-    with pytest.raises(ValueError, match="sliding = 'large' is invalid"):
-        ContactInterface(V, scene.facet_tags, *scene.contact_pair, law=law, sliding="large")
+    with pytest.raises(ValueError, match="sliding = 'huge' is invalid: it must be 'small', "
+                       "'moderate' or 'large'"):
+        ContactInterface(V, scene.facet_tags, *scene.contact_pair, law=law, sliding="huge")
 
 
-def test_moderate_sliding_resumes_exactly(tmp_path):
+@pytest.mark.parametrize("sliding", ["moderate", "large"])
+def test_sliding_resumes_exactly(tmp_path, sliding):
     """A checkpoint holds the pairing its increment used: stopped after 5 increments (mid-slide,
     partners already changed) and resumed, the run ends as the uninterrupted one (displacements
     to 1e-12 of their maximum)."""
     directory = MPI.COMM_WORLD.bcast(str(tmp_path / "ck"), root=0)
-    full = _run("moderate", friction=0.3)
-    part = _run("moderate", friction=0.3, checkpoint=directory, max_steps=5)
+    full = _run(sliding, friction=0.3)
+    part = _run(sliding, friction=0.3, checkpoint=directory, max_steps=5)
     assert len(part["incs"]) == 5 and part["n_repairs"] >= 2
-    rest = _run("moderate", friction=0.3, checkpoint=directory, resume=directory)
+    rest = _run(sliding, friction=0.3, checkpoint=directory, resume=directory)
     assert [i.step for i in rest["incs"]] == [i.step for i in full["incs"]][5:]
     scale = MPI.COMM_WORLD.allreduce(float(np.abs(full["u"]).max()), op=MPI.MAX)
     np.testing.assert_allclose(rest["u"], full["u"], rtol=0, atol=1e-12 * scale)

@@ -27,7 +27,7 @@ from mpi4py import MPI
 from rough_contact.fem.pairing.facets import FacetGeometry, FacetRule, cmap_element
 
 __all__ = ["SurfaceContext", "Partners", "PairedPoints", "Pairing", "SlidingPairing",
-           "first_surface_points", "local_frames"]
+           "Repaired", "first_surface_points", "local_frames"]
 
 
 @dataclass(frozen=True)
@@ -121,28 +121,54 @@ class Pairing(Protocol):
         ...
 
 
-@runtime_checkable
-class SlidingPairing(Protocol):
-    """A pairing that finds new partners on the deformed surfaces (large or moderate sliding).
+@dataclass(frozen=True)
+class Repaired:
+    """What a sliding pairing found on the deformed configuration (one re-pairing).
 
-    Kinematics: every point keeps its place on the first surface, its frame and its law state;
-    its current position is projected along its normal onto the deformed second surface. The
-    interface keeps the tangential jump continuous across a change of partner and takes the
-    normal gap from the projection.
+    Attributes:
+        partners: the new partners with zero ``gap0`` (None for a rigid counter-surface). A
+            point without partner (``active`` False) has partner facet -1, zero shape values
+            and its own facet's closure nodes (no new matrix entries).
+        gap: (n,) normal gap [mm] at the configuration it was found on (0 where inactive).
+        frames: (n, 3, 3) new local frames (rows n, x, y), or None: unchanged.
+        active: (n,) bool: the point has a partner (a point that slid off the second surface,
+            or separated beyond the search radius, has none: zero traction).
+        anchor: (n, 3) where the partner point (or the closest point of a rigid surface) is
+            in the current configuration [mm]: the pairing's fixed point is reached when it
+            stops moving.
     """
 
-    def repair(self, u_local: np.ndarray, paired: PairedPoints) -> tuple[Partners, np.ndarray]:
-        """(new partners with zero ``gap0``, (n,) normal distances [mm] to them) on the
-        surfaces deformed by ``u_local`` (this rank's displacement values with ghosts,
-        (n_nodes, 3)). Raises ValueError (every rank) when points lost their partner."""
+    partners: Optional[Partners]
+    gap: np.ndarray
+    frames: Optional[np.ndarray]
+    active: np.ndarray
+    anchor: np.ndarray
+
+
+@runtime_checkable
+class SlidingPairing(Protocol):
+    """A pairing that finds new partners on the deformed surfaces (moderate or large sliding).
+
+    Kinematics: every point keeps its place on the first surface and its law state; its current
+    position is projected along its normal onto the deformed second surface (or onto a rigid
+    surface moved by ``translation``). The interface keeps the tangential jump continuous
+    across a change of partner, takes the normal gap from the re-pairing, and makes points
+    without partner inactive.
+    """
+
+    def repair(self, u_local: np.ndarray, paired: PairedPoints,
+               translation: np.ndarray) -> Repaired:
+        """The pairing on the configuration deformed by ``u_local`` (this rank's displacement
+        values with ghosts, (n_nodes, 3)), a rigid counter-surface translated by
+        ``translation`` (3,) [mm] (collective)."""
         ...
 
     def state(self) -> object:
-        """What a checkpoint must store to rebuild the current partners (picklable)."""
+        """What a checkpoint must store to rebuild the current pairing (picklable)."""
         ...
 
-    def restore(self, state: object) -> Optional[Partners]:
-        """Reinstate :meth:`state`; the partners it describes (None: the set-up ones)."""
+    def restore(self, state: object) -> Optional[Repaired]:
+        """Reinstate :meth:`state`; the pairing it describes (None: the set-up one)."""
         ...
 
 

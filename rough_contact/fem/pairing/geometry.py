@@ -119,6 +119,48 @@ def project_points(x: np.ndarray, normal: np.ndarray, surface: SecondSurface, cm
     return _project(x, normal, surface, cmap, search_radius, n_candidates, inside_tol, max_iter)
 
 
+def project_points_from(previous: np.ndarray, x: np.ndarray, normal: np.ndarray,
+                        surface: SecondSurface, cmap, search_radius: float,
+                        inside_tol: float = 1e-8, max_iter: int = 25) -> Projection:
+    """:func:`project_points` started from each point's previous partner facet (a re-pairing
+    after a small motion): a point whose normal still meets its previous facet, within the
+    search radius and facing it, keeps it; only the others (and points without a previous
+    facet, ``previous`` -1) are searched for among the nearest facets.
+
+    Args:
+        previous: (n,) previous partner facet of every point (-1: none).
+        others: as :func:`project_points`.
+    """
+    n = x.shape[0]
+    if n == 0 or surface.size == 0:
+        return project_points(x, normal, surface, cmap, search_radius)
+    cand = np.where(previous < surface.size, previous, -1).reshape(n, 1).astype(np.int64)
+    result = _candidates(x, normal, surface, cand, cmap, search_radius, inside_tol, max_iter)
+    # points that left their facet: the facet of the nearest centroid, then a search as at
+    # set-up for those it does not hold; points that had no partner (beyond an edge): their 4
+    # nearest facets only
+    was_off = cand[:, 0] < 0
+    tree = None
+    for group in ("nearest", "off", "full"):
+        missing = result.facet < 0
+        retry = np.flatnonzero(missing & (was_off if group == "off" else ~was_off))
+        if retry.size == 0:
+            continue
+        if group == "full":
+            again = project_points(x[retry], normal[retry], surface, cmap, search_radius,
+                                   inside_tol=inside_tol, max_iter=max_iter)
+        else:
+            tree = cKDTree(surface.centroid) if tree is None else tree
+            again = _candidates(x[retry], normal[retry], surface,
+                                _nearest(tree, x[retry], 1 if group == "nearest" else 4), cmap,
+                                search_radius, inside_tol, max_iter)
+        merged = [getattr(result, f).copy() for f in Projection.__dataclass_fields__]
+        for arr, new in zip(merged, (getattr(again, f) for f in Projection.__dataclass_fields__)):
+            arr[retry] = new
+        result = Projection(*merged)
+    return result
+
+
 def tabulate(element, nderiv: int, X: np.ndarray) -> np.ndarray:
     """``element.tabulate(nderiv, X)`` as (n_derivatives, m, dim); safe for m = 0 (basix
     asserts on an empty point set)."""

@@ -12,15 +12,16 @@ Units: mm.
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Optional
 
 import numpy as np
 from mpi4py import MPI
 
-from rough_contact.fem.pairing.base import (PairedPoints, Partners, SurfaceContext,
+from rough_contact.fem.pairing.base import (PairedPoints, Partners, Repaired, SurfaceContext,
                                             first_surface_points, local_frames)
 from rough_contact.fem.pairing.facets import GatheredSurface, cmap_element, facet_set
-from rough_contact.fem.pairing.geometry import project_points, tabulate
+from rough_contact.fem.pairing.geometry import project_points, project_points_from, tabulate
 from rough_contact.validation import check_scalar
 
 __all__ = ["ProjectionPairing", "SlidingProjectionPairing", "facet_areas"]
@@ -154,9 +155,12 @@ class ProjectionPairing:
 
 
 class SlidingProjectionPairing(ProjectionPairing):
-    """The projection pairing redone on the deformed surfaces at the start of every increment
-    (moderate sliding; a :class:`~rough_contact.fem.pairing.base.SlidingPairing`). Needs a
-    displacement space of the geometry's degree (the surfaces move exactly with u).
+    """The projection pairing redone on the deformed surfaces (a
+    :class:`~rough_contact.fem.pairing.base.SlidingPairing`): at the start of every increment
+    (moderate sliding) or until it stops changing within the increment (large sliding; the
+    interface drives it). A point whose normal no longer meets the second surface within the
+    search radius (it slid off its edge, or separated) is inactive until it finds one again.
+    Needs a displacement space of the geometry's degree (the surfaces move exactly with u).
     """
 
     def __init__(self, second_tag: int, search_radius: Optional[float] = None):
@@ -164,9 +168,11 @@ class SlidingProjectionPairing(ProjectionPairing):
         self._projection = None          # the last re-pairing's projection (None: set-up)
 
     # ------------------------------------------------------------------ sliding capability
-    def repair(self, u_local: np.ndarray, paired: PairedPoints) -> tuple[Partners, np.ndarray]:
-        """Partners on the surfaces deformed by ``u_local`` (n_nodes, 3) (collective; see
-        :class:`~rough_contact.fem.pairing.base.SlidingPairing`)."""
+    def repair(self, u_local: np.ndarray, paired: PairedPoints,
+               translation: Optional[np.ndarray] = None) -> Repaired:
+        """The pairing on the surfaces deformed by ``u_local`` (n_nodes, 3) (collective; see
+        :class:`~rough_contact.fem.pairing.base.SlidingPairing`; ``translation`` is unused:
+        the second surface moves with its own displacements)."""
         ctx, sec = self._ctx, self._second
         n_f, nq, n_close = paired.N1.shape
         x1 = paired.x + np.einsum("fqk,fki->fqi", paired.N1,
@@ -178,21 +184,39 @@ class SlidingProjectionPairing(ProjectionPairing):
         cell_x[rows, sec.closure[sec.local_facet]] += u2   # Lagrange: facet = its closure
         nv = sec.vertex_x.shape[1]
         surface = facet_set(ctx.V.mesh, cell_x, sec.local_facet, sec.vertex_x + u2[:, :nv])
-        proj = project_points(x1, paired.frames[:, 0, :], surface, cmap_element(ctx.V.mesh),
-                              self.search_radius)
-        self._check(proj, x1, after="after sliding: ")
+        previous = (self._projection.facet if self._projection is not None
+                    else paired.partners.facet.reshape(-1))
+        proj = project_points_from(previous, x1, paired.frames[:, 0, :], surface,
+                                   cmap_element(ctx.V.mesh), self.search_radius)
         self._projection = proj
-        return self._zero_gap(self._partners(proj, (n_f, nq))), proj.distance
+        return self._repaired(proj, x1, paired.frames[:, 0, :])
+
+    def _repaired(self, proj, x1: Optional[np.ndarray], normal: np.ndarray) -> Repaired:
+        """The :class:`Repaired` of a projection (points without partner inactive)."""
+        n_f, nq = self._ctx.geo1.facets.size, self._ctx.rule.nq
+        active = proj.facet >= 0
+        facet = np.where(active, proj.facet, 0)
+        p = self._partners(replace(proj, facet=facet), (n_f, nq))
+        shape = (n_f, nq)
+        act = active.reshape(shape)
+        own_nodes = np.broadcast_to(self._ctx.geo1.global_nodes[:, None, :], p.nodes2.shape)
+        partners = Partners(N2=np.where(act[..., None], p.N2, 0.0),
+                            nodes2=np.where(act[..., None], p.nodes2, own_nodes),
+                            facet=np.where(act, p.facet, -1), remote=p.remote & act,
+                            gap0=np.zeros(shape), copy_of=p.copy_of)
+        gap = np.where(active, proj.distance, 0.0)
+        anchor = None if x1 is None else x1 + gap[:, None] * normal
+        return Repaired(partners=partners, gap=gap, frames=None, active=active, anchor=anchor)
 
     def state(self) -> object:
         """The last re-pairing's projection (None: the set-up pairing)."""
         return self._projection
 
-    def restore(self, state: object) -> Optional[Partners]:
-        """Reinstate :meth:`state`; its partners (zero gap), or None for the set-up pairing."""
+    def restore(self, state: object) -> Optional[Repaired]:
+        """Reinstate :meth:`state`; its pairing (``gap`` and ``anchor`` are not restored: the
+        interface restores its jump offsets), or None for the set-up pairing."""
         self._projection = state
         if state is None:
             return None
-        n_f = self._ctx.geo1.facets.size
-        nq = self._ctx.rule.nq
-        return self._zero_gap(self._partners(state, (n_f, nq)))
+        n = self._ctx.geo1.facets.size * self._ctx.rule.nq
+        return self._repaired(state, None, np.zeros((n, 3)))
