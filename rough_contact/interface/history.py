@@ -53,6 +53,7 @@ from __future__ import annotations
 
 import math
 import time
+import warnings
 from dataclasses import dataclass, field
 from typing import Optional, Protocol, Tuple, runtime_checkable
 
@@ -61,7 +62,7 @@ import numpy as np
 from ..validation import check_scalar
 from .normal import NormalLaw
 
-__all__ = ["HistoryNormalLawProtocol", "HistoryNormalLaw"]
+__all__ = ["HistoryNormalLawProtocol", "HistoryNormalLaw", "UnloadingAboveLoadingWarning"]
 
 
 @runtime_checkable
@@ -246,6 +247,7 @@ class HistoryNormalLaw:
     _D: Optional[np.ndarray] = None     # (n_m + 1,) D(h_min) at the rows [N/mm]
     _dD: Optional[np.ndarray] = None    # (n_m + 1,) dD/dh_min at the rows (monotone slopes)
     _IL: float = 0.0                    # int exp(rho(row 0, x)) dx incl. taper [-]
+    _capped: bool = False               # the sums went above the loading branch: cap by it
     info: dict = field(default_factory=dict, compare=False)   # build statistics, not identity
 
     def __setstate__(self, state):
@@ -345,6 +347,8 @@ class HistoryNormalLaw:
         hL, hE = loading.h_min, loading.h_table_end
         cache: dict = {}
         n_pts = [0]
+        n_capped = [0]
+        _CAP_WORST[0] = 0.0
 
         def model(hms, xs):
             """(rho, d rho/dx, ln a - ln a0, d ln a/dx) (4, len(hms), len(xs)), cached per
@@ -361,9 +365,12 @@ class HistoryNormalLaw:
                     n_pts[0] += uu.size
                     p = np.maximum(p, 1e-300)
                     a = np.maximum(a, 1e-300)
-                    for x, pv, kv, av, dav in zip(need, p[1:], k[1:], a[1:], da[1:]):
-                        row[round(float(x), 12)] = (math.log(pv / p[0]), -kv / pv * sig,
-                                                    math.log(av / a[0]), -dav / av * sig)
+                    vals = np.stack([np.log(p[1:] / p[0]), -k[1:] / p[1:] * sig,
+                                     np.log(a[1:] / a[0]), -da[1:] / a[1:] * sig])
+                    n_capped[0] += _count_above_loading(vals[0], loading, float(hm), uu[1:],
+                                                        rtol, tail)
+                    for x, col in zip(need, vals.T):
+                        row[round(float(x), 12)] = tuple(float(c) for c in col)
                 for j, x in enumerate(xs):
                     out[:, i, j] = row[round(float(x), 12)]
             return out
@@ -436,9 +443,20 @@ class HistoryNormalLaw:
                     f"({nm} rows intervals x {xk.size - 1} x intervals; x check error "
                     f"{worst_x:.2g}): loosen rtol or raise the budget") from None
         hm, m = table
-        law = cls._assemble(loading, rtol, sig, hm, xk, m, beta)
+        law = cls._assemble(loading, rtol, sig, hm, xk, m, beta, capped=n_capped[0] > 0)
         ok = law._check_monotone()
         worst = worst_x + worst_m
+        if n_capped[0]:
+            warnings.warn(
+                f"HistoryNormalLaw: the summits' unloading sums exceed the loading law at "
+                f"{n_capped[0]} of {n_pts[0]} table points (up to a factor "
+                f"{math.exp(_CAP_WORST[0]):.4g}): with these yield data one summit's load jumps "
+                f"up where it starts to yield (Zhao-Maietta-Chang at omega_c above the Hertz "
+                f"load), and its elastic unloading from the jump would return more work than "
+                f"the loading took. The unloading branch is capped by the loading branch "
+                f"there (no memory, less normal dissipation); docs/unloading.md",
+                UnloadingAboveLoadingWarning, stacklevel=2)
+        law.info.update({"capped_points": int(n_capped[0])})
         law.info.update({"build_seconds": time.perf_counter() - t0, "loading_seconds": t_load,
                          "history_seconds": time.perf_counter() - t1, "rows": hm.size - 2,
                          "x_knots": xk.size, "X": X, "model_points": n_pts[0],
@@ -450,7 +468,7 @@ class HistoryNormalLaw:
         return law
 
     @classmethod
-    def _assemble(cls, loading, rtol, sig, hm, xk, m, beta, energy=True):
+    def _assemble(cls, loading, rtol, sig, hm, xk, m, beta, energy=True, capped=False):
         """The law from row data m (4, n_m + 3, n_knots) on the rows hm (uniform in v, the
         first and the last a ghost row beyond the table) and the x knots xk."""
         n_m, n_x = hm.size - 3, xk.size - 1
@@ -473,7 +491,7 @@ class HistoryNormalLaw:
                   _span=float(hm[-1] - hm[0]), _beta=float(beta),
                   _X=float(xk[-1]), _xk=xk, _xinv=1.0 / dxk, _xinv_h=1.0 / (dxk * sig),
                   _xnext=nxt, _lut=lut,
-                  _lut_inv=1.0 / w, _CF=CF, _n_m=n_m,
+                  _lut_inv=1.0 / w, _CF=CF, _n_m=n_m, _capped=bool(capped),
                   info={"monotone_projection_changes": ch1 + ch2})
         if not energy:
             return law
@@ -484,11 +502,24 @@ class HistoryNormalLaw:
         xq = (xk[:-1, None] + dxk[:, None] * g).ravel()
         wq = (dxk[:, None] * wg).ravel()
         I = np.zeros(n_m + 1)
+        if capped:      # the capped branch has a kink inside a cell: 8 Gauss panels per cell
+            sub = (np.arange(8)[:, None] + g) / 8.0
+            xq8 = (xk[:-1, None, None] + dxk[:, None, None] * sub).ravel()
+            wq8 = np.broadcast_to((dxk[:, None, None] * wg / 8.0), (dxk.size, 8, g.size)).ravel()
         for r in range(n_m + 1):
-            v, _, _ = law._rho(np.full(xq.size, hm[r]), xq)
-            I[r] = np.sum(wq * np.exp(v))
             vX, dvX, _ = law._rho(np.full(1, hm[r]), np.full(1, xk[-1]))
             pX, kX = math.exp(vX[0]), -math.exp(vX[0]) * dvX[0]      # per unit x
+            if capped:
+                # the branch as evaluated (never above the loading branch), taper included,
+                # by quadrature of evaluate_history itself
+                L = 3.0 * pX / kX if kX > 0 else 1.0
+                xs = np.concatenate([xq8, xk[-1] + L * sub.ravel()])
+                ws = np.concatenate([wq8, np.tile(L * wg / 8.0, 8)])
+                pu = law.evaluate_history(hm[r] + sig * xs, np.full(xs.size, hm[r]))[0]
+                I[r] = np.sum(ws * pu) / max(loading.evaluate(hm[r:r + 1])[0][0], 1e-300)
+                continue
+            v, _, _ = law._rho(np.full(xq.size, hm[r]), xq)
+            I[r] = np.sum(wq * np.exp(v))
             if kX > 0:
                 I[r] += pX * (3.0 * pX / kX) / 4.0
         p0 = loading.evaluate(hm)[0]
@@ -592,6 +623,17 @@ class HistoryNormalLaw:
             a[tp] = ae * (1 - t) ** 3
             if curvature:
                 dk[tp] = -6.0 * pe / (L * L) * (1 - t)
+        if self._capped:
+            # never above the loading branch at the same separation (build warning): there
+            # the point follows the loading branch (values and tangent) without memory
+            lp, lk, la = np.empty(h.size), np.empty(h.size), np.empty(h.size)
+            ld = np.empty(h.size) if curvature else None
+            self.loading._eval_block(h, lp, lk, la, ld)
+            up = np.flatnonzero(p > lp)
+            if up.size:
+                p[up], k[up], a[up] = lp[up], lk[up], la[up]
+                if curvature:
+                    dk[up] = ld[up]
         out[0][idx], out[1][idx], out[2][idx] = p, k, a
         if curvature:
             out[3][idx] = dk
@@ -622,6 +664,31 @@ class HistoryNormalLaw:
             p0 = self.loading.evaluate(hb)[0]
             out[below] = np.maximum(W - self.sigma * p0 * self._IL, 0.0)
         return out.reshape(hm.shape)
+
+
+class UnloadingAboveLoadingWarning(UserWarning):
+    """The direct sums put an unloading branch above the loading one (capped by it)."""
+
+
+_CAP_WORST = [0.0]      # largest ln(p_unload / p_load(h)) met by the last build (its warning)
+
+
+def _count_above_loading(rho, loading, h_min, u, rtol, tail=1e-12) -> int:
+    """Number of one row's points (rho at u = h - h_min [mm]) where the direct sums put the
+    unloading branch above the loading branch, ln p_u/p_load(h) > rtol (below rtol the sums
+    and the loading table agree to their accuracy, e.g. on rows where nothing has yielded),
+    among the points where both branches are above ``tail`` p_load(h_min) and h is inside the
+    loading table (beyond it the loading law's taper ends at its h_max while the sums go on);
+    records the largest excess
+    for the build's warning."""
+    pl = loading.evaluate(np.concatenate([[h_min], h_min + np.asarray(u, float)]))[0]
+    r_load = np.log(np.maximum(pl[1:], 1e-300) / max(pl[0], 1e-300))
+    use = ((r_load >= math.log(tail)) & (np.asarray(rho) >= math.log(tail))
+           & (h_min + np.asarray(u, float) < loading.h_table_end))
+    excess = (np.asarray(rho) - r_load)[use]
+    if excess.size:
+        _CAP_WORST[0] = max(_CAP_WORST[0], float(excess.max()))
+    return int(np.count_nonzero(excess > rtol))
 
 
 class _Budget(Exception):

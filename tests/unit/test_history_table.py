@@ -34,7 +34,7 @@ def _loading():
     return NormalLaw.from_model(model, (-1e-3, 5e-3), rtol=1e-8)
 
 
-def _synthetic(rho, drho, la, dla, n=6, xk=XK, loading=None):
+def _synthetic(rho, drho, la, dla, n=6, xk=XK, loading=None, capped=False):
     """HistoryNormalLaw from closed-form row data rho(v, x), d rho/dx, ln a/a0, d/dx."""
     loading = loading or _loading()
     hL, hE = loading.h_min, loading.h_table_end
@@ -42,7 +42,7 @@ def _synthetic(rho, drho, la, dla, n=6, xk=XK, loading=None):
     hm = H._row_h(v, hL, hE - hL, H._GRADING)
     V, X = np.meshgrid(v, xk, indexing="ij")
     m = np.array([rho(V, X), drho(V, X), la(V, X), dla(V, X)])
-    return HistoryNormalLaw._assemble(loading, 1e-3, SIG, hm, xk, m, H._GRADING)
+    return HistoryNormalLaw._assemble(loading, 1e-3, SIG, hm, xk, m, H._GRADING, capped=capped)
 
 
 # a surface cubic in v and quadratic in x (exact for the table), decreasing in x
@@ -224,3 +224,43 @@ def test_pickle_roundtrip_and_old_format_refused():
     old = object.__new__(HistoryNormalLaw)
     with pytest.raises(ValueError, match="older format"):
         old.__setstate__({"loading": law.loading, "_C": np.zeros((1, 1, 4, 4)), "_dm": 1.0})
+
+
+
+def test_unloading_above_loading_is_capped_by_the_loading_branch():
+    """A population cannot give back more force on unloading than it took on loading at the
+    same separation (its normal dissipation would be negative: the paper's yield data make one
+    summit's load jump up at first yield, and the elastic unloading from the jump lies above
+    the loading curve). A table flagged as crossing the loading branch is evaluated as
+    min(unloading, loading) with the tangent of the branch taken; its D(h_min) is the loading
+    work minus the recoverable energy of that capped branch (trapezoid rule here); the build's
+    detector counts the points above the loading branch by more than rtol only."""
+    # loading ln p = -h/LAM, so rho_load(x) = -x (SIG = LAM); this branch crosses it at x = 5
+    rho = lambda v, x: -(1.5 + 0.2 * v) * x + 0.1 * x * x
+    drho = lambda v, x: -(1.5 + 0.2 * v) + 0.2 * x
+    free = _synthetic(rho, drho, _la, _dla)
+    law = _synthetic(rho, drho, _la, _dla, capped=True)
+    rng = np.random.default_rng(3)
+    hm = law.h_min + rng.random(20000) * (law.h_table_end - law.h_min)
+    h = hm + rng.random(20000) * 8 * SIG
+    p, k, a = law.evaluate_history(h, hm)
+    pf, kf, af = free.evaluate_history(h, hm)
+    pl, kl, al = law.loading.evaluate(h)
+    assert np.all(p <= pl * (1 + 1e-14))
+    above = pf > pl
+    assert above.mean() > 0.05                     # the uncapped table does cross
+    np.testing.assert_array_equal(p[~above], pf[~above])
+    np.testing.assert_array_equal(k[above], kl[above])
+    np.testing.assert_array_equal(a[above], al[above])
+    # dissipation of the capped branch: work minus the energy it gives back
+    n_m = law._n_m
+    rows = H._row_h(np.arange(n_m + 1) / n_m, law._hm0, law._span, law._beta)
+    for r in rows[:-1:2]:
+        hh = np.linspace(r, law.h_max + 2 * SIG, 400001)
+        W = trapezoid(law.loading.evaluate(hh)[0], hh)
+        E = trapezoid(law.evaluate_history(hh, np.full_like(hh, r))[0], hh)
+        assert float(law.normal_dissipation(np.array([r]))[0]) == pytest.approx(W - E, rel=1e-5)
+    # the detector: one point above by 0.3, one below, one above by rtol/2 (not counted)
+    u = np.array([0.25, 0.5, 1.0]) * SIG
+    r_load = -u / LAM
+    assert H._count_above_loading(r_load + [0.3, -0.2, 0.5e-4], law.loading, 1e-3, u, 1e-4) == 1
