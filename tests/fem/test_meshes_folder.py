@@ -25,9 +25,17 @@ MESHES = Path(__file__).resolve().parents[2] / "meshes"
 
 
 def _script(name):
-    spec = importlib.util.spec_from_file_location(f"meshes_{name}", MESHES / f"{name}.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
+    """The meshes/ script as a module. Its ``import _common`` must find meshes/_common.py, not
+    another folder's ``_common`` a test imported before (benchmarks/ and demos/ have one)."""
+    import sys
+    saved = sys.modules.pop("_common", None)
+    try:
+        spec = importlib.util.spec_from_file_location(f"meshes_{name}", MESHES / f"{name}.py")
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+    finally:
+        if saved is not None:
+            sys.modules["_common"] = saved
     return module
 
 
