@@ -143,6 +143,16 @@ def nodal_points(ctx: SurfaceContext, paired: PairedPoints, op: JumpOperator) ->
     t_vid = np.repeat(vid[group_facet], nn, axis=1).reshape(-1)       # (n_g * nv * nn,)
     t_node = np.broadcast_to(group_nodes[:, None, :], (n_g, nv, nn)).reshape(-1)
     t_val = G.reshape(n_g, nv, 3, nn, 3).transpose(0, 1, 3, 2, 4).reshape(-1, 3, 3)
+    # components of the vertex's own displacement fixed by a Dirichlet condition (rows -1 of
+    # the quadrature operator): a symmetry plane through the vertex, mirrored below
+    m_keys = 3 * V.dofmap.index_map.size_global
+    flat = (np.arange(n_g)[:, None] * m_keys + op._pair_dofs).reshape(-1)
+    own_dofs = (np.arange(n_g)[:, None, None] * m_keys + 3 * vid[group_facet][:, :, None]
+                + np.arange(3))
+    pos = np.minimum(np.searchsorted(flat, own_dofs), max(flat.size - 1, 0))
+    f_fixed = (op._rows.reshape(-1)[pos] < 0) if flat.size else np.zeros((0, nv, 3), bool)
+    f_vid = vid[group_facet].reshape(-1)
+    f_fixed = f_fixed.reshape(-1, 3)
     keep = np.any(t_val != 0.0, axis=(1, 2))
     t_vid, t_node, t_val = t_vid[keep], t_node[keep], t_val[keep]
     # send everything to the rank owning the vertex's DOF
@@ -153,14 +163,17 @@ def nodal_points(ctx: SurfaceContext, paired: PairedPoints, op: JumpOperator) ->
     dest_t = np.searchsorted(ranges, t_vid, side="right") - 1
     a_vals = np.concatenate([vid.reshape(-1, 1).astype(float), m_fv.reshape(-1, 1),
                              n_fv.reshape(-1, 3), j0_fv.reshape(-1, 3)], axis=1)
-    send = [(a_vals[dest_v == r], t_vid[dest_t == r], t_node[dest_t == r], t_val[dest_t == r])
-            for r in range(comm.size)]
+    dest_f = np.searchsorted(ranges, f_vid, side="right") - 1
+    send = [(a_vals[dest_v == r], t_vid[dest_t == r], t_node[dest_t == r], t_val[dest_t == r],
+             f_vid[dest_f == r], f_fixed[dest_f == r]) for r in range(comm.size)]
     recv = comm.alltoall(send)
     a_vals = np.concatenate([r[0] for r in recv])
     a_vid = a_vals[:, 0].astype(np.int64)
     t_vid = np.concatenate([r[1] for r in recv]).astype(np.int64)
     t_node = np.concatenate([r[2] for r in recv]).astype(np.int64)
     t_val = np.concatenate([r[3] for r in recv]).reshape(-1, 3, 3)
+    f_vid = np.concatenate([r[4] for r in recv]).astype(np.int64)
+    f_fixed = np.concatenate([r[5] for r in recv]).reshape(-1, 3)
     verts, iv = np.unique(a_vid, return_inverse=True)
     n_v = verts.size
     m = np.bincount(iv, weights=a_vals[:, 1], minlength=n_v)
@@ -188,6 +201,14 @@ def nodal_points(ctx: SurfaceContext, paired: PairedPoints, op: JumpOperator) ->
     nodes[kv, col] = kn
     pad = np.ones((n_v, width), dtype=bool)
     pad[kv, col] = False
+    # a component fixed at the vertex is a mirror plane: the vertex's patch is half of a
+    # symmetric one whose weighted jump and normal have no component along it
+    hits = np.zeros((n_v, 3))
+    np.add.at(hits, np.searchsorted(verts, f_vid), f_fixed.astype(float))
+    fixed = hits > 0.0
+    A[fixed] = 0.0
+    sums[:, :3][fixed] = 0.0
+    sums[:, 3:][fixed] = 0.0
     # vertex frames and coordinates
     normal = sums[:, :3] / np.maximum(np.linalg.norm(sums[:, :3], axis=1), 1e-300)[:, None]
     x = V.tabulate_dof_coordinates()[(verts - r0).astype(np.int64)].reshape(n_v, 3)
@@ -266,7 +287,7 @@ class NodalContactInterface(ContactInterface):
         super().__init__(V, facet_tags, first_tag, second_tag, **kwargs)
 
     def _point_set(self, ctx: SurfaceContext, bcs: Sequence) -> JumpOperator:
-        quad = JumpOperator(ctx.V, self.paired)
+        quad = JumpOperator(ctx.V, self.paired, bcs=bcs)
         self.quadrature_points = self.paired
         self.nodal = nodal_points(ctx, self.paired, quad)
         nodal = self.nodal

@@ -82,13 +82,16 @@ def _patch(mesh, order, pairing, friction, cell_type="tetrahedron", comm=MPI.COM
 
 
 PATCH = [("conforming", 1, "conforming"), ("conforming", 2, "conforming"),
-         ("nonmatching", 1, "mortar"), ("nonmatching", 2, "mortar")]
+         ("nonmatching", 1, "mortar"), ("nonmatching", 2, "mortar"),
+         ("conforming", 2, "conforming", "hexahedron"),
+         ("nonmatching", 1, "mortar", "hexahedron"), ("nonmatching", 2, "mortar", "hexahedron")]
 
 
-@pytest.mark.parametrize("case", PATCH, ids=lambda c: f"{c[2]}-P{c[1]}")
+@pytest.mark.parametrize("case", PATCH, ids=lambda c: f"{c[2]}-{'Q' if len(c) > 3 else 'P'}{c[1]}")
 @pytest.mark.parametrize("friction", [False, True], ids=["frictionless", "coulomb-exact"])
 def test_patch_uniform_pressure_is_transmitted_exactly(case, friction):
-    p_err, s_err, force, slipping, area, ci = _patch(*case, friction)
+    mesh, order, pairing, *cell = case
+    p_err, s_err, force, slipping, area, ci = _patch(mesh, order, pairing, friction, *cell)
     assert p_err <= 1e-8
     assert abs(area - 1.0) <= 1e-10                  # sum of m_j: the whole face
     np.testing.assert_allclose(force, [0.0, 0.0, PRESSURE], atol=1e-8 * PRESSURE)
