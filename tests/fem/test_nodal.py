@@ -174,3 +174,35 @@ def test_rank_independent_and_jacobian(pairing, order):
     np.testing.assert_allclose(world, serial, rtol=1e-10)
     assert abs(world[-1] - 1.0) <= 1e-10
     assert fd_err < 1e-6
+
+
+@pytest.mark.parametrize("cell", ["tetrahedron", "hexahedron"])
+def test_vertex_functions_in_the_p2_facet_basis(cell):
+    """N_j = sum_k M_kj phi_k: the first-order vertex function of vertex j at every closure
+    node of a P2 triangle is the node's barycentric coordinate; on a Q2 square 1 at j, 1/2 at
+    the mid-nodes of the edges through j, 1/4 at the centre node (bilinear), 0 elsewhere; the
+    N_j sum to 1 at every node."""
+    import dolfinx
+    from rough_contact.fem.nodal import vertex_shape_matrix
+    kind = getattr(dolfinx.mesh.CellType, cell)
+    msh = dolfinx.mesh.create_unit_cube(MPI.COMM_SELF, 1, 1, 1, kind)
+    V = compat.vector_space(msh, 2)
+    M, vclose = vertex_shape_matrix(V)
+    X = np.asarray(V.element.basix_element.points)
+    closure = np.array(V.element.basix_element.entity_closure_dofs[2])
+    for lf in range(closure.shape[0]):
+        nodes = X[closure[lf]]                      # (n_close, 3) reference coordinates
+        corners = nodes[vclose[lf]]                 # (nv, 3)
+        for k, x in enumerate(nodes):
+            d = np.linalg.norm(corners - x, axis=1)
+            expected = np.zeros(corners.shape[0])
+            if corners.shape[0] == 3:               # barycentric coordinates of x
+                A = np.vstack([corners.T, np.ones(3)])
+                expected = np.linalg.lstsq(A, np.append(x, 1.0), rcond=None)[0]
+            elif np.min(d) < 1e-12:                 # a square's vertex node
+                expected[np.argmin(d)] = 1.0
+            else:                                   # a square's mid-node or centre: equal
+                near = np.isclose(d, d.min())       # shares of the nearest corners
+                expected[near] = 1.0 / near.sum()
+            np.testing.assert_allclose(M[lf, k], expected, atol=1e-12)
+        np.testing.assert_allclose(M[lf].sum(axis=1), 1.0, atol=1e-12)
