@@ -14,7 +14,6 @@ from __future__ import annotations
 import argparse
 import time
 
-import numpy as np
 from petsc4py import PETSc
 
 from rough_contact import references
