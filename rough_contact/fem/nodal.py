@@ -297,3 +297,8 @@ class NodalContactInterface(ContactInterface):
             frames=nodal.frames, jump0=nodal.jump0, N1=np.zeros((n_v, 1, 0)),
             nodes1=nodal.vertex[:, None], partners=None, name="nodal")
         return VertexJumpOperator(ctx.V, nodal, bcs=bcs)
+
+    def describe(self) -> dict:
+        """``ContactInterface.describe`` plus the point set (a checkpoint of the quadrature
+        route is not resumed on vertex points, nor the other way round)."""
+        return dict(super().describe(), points="nodal")
