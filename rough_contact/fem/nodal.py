@@ -24,7 +24,10 @@ Each vertex row combines the rows of all the vertex's facets (and their partners
 "group" per vertex with a variable number of DOFs, padded to the rank's largest count with
 zero columns whose matrix rows are skipped (-1). A vertex shared by facets on several ranks is
 assembled on the rank that owns its DOF (its global index): every rank sends its partial sums
-there once at set-up; a rank without contact facets is normal. The penalty, the
+there once at set-up; a rank without contact facets is normal. A displacement component of
+the vertex fixed by a Dirichlet condition (a symmetry plane through it) is a mirror: the
+weighted jump and normal of its half patch get no component along that axis, as the full
+symmetric patch would have none. The penalty, the
 augmented-Lagrangian enforcement and the friction history then work unchanged on the vertex
 points.
 
