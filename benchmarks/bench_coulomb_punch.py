@@ -10,7 +10,7 @@ increment, CPU time and the dissipation at the peak and at the end.
 
     OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bench_coulomb_punch.py \\
         [--levels 1 2 3] [--mu 0.2 0.5] [--k 1e7] [--predictor none secant]
-        [--reversal-stiffness 0 1] [--augmented 0 1] [--al-tol 1e-3]
+        [--quadrature gauss vertex nodal] [--reversal-stiffness 0 1] [--augmented 0 1] [--al-tol 1e-3]
         [--continuation none 100,10] [--after 10] [--linear-solver auto mumps hypre] [--csv FILE]
 
 Levels (P1; mesh and contact size in LEVELS): 1 ~4.5 k DOFs, 2 ~26 k, 3 ~73 k, 4 ~99 k (the size
@@ -52,7 +52,9 @@ def run(level: int, mu: float, k: float, width: float, predictor: str, quadratur
                           reversal_stiffness=reversal_stiffness)
     enforcement = AugmentedLagrangian(tolerance=al_tol) if augmented else Penalty()
     m = flat_punch.build(comm, mesh_size=mesh_size, contact_size=contact_size, order=1,
-                         load_half_width=10.0, law=law, steps=N_LOAD, quadrature=quadrature,
+                         load_half_width=10.0, law=law, steps=N_LOAD,
+                         quadrature="gauss" if quadrature == "nodal" else quadrature,
+                         points="nodal" if quadrature == "nodal" else "quadrature",
                          enforcement=enforcement,
                          solver_options=dict(continuation=continuation,
                                              linear_solver=linear_solver))
@@ -98,7 +100,9 @@ def main(argv=None):
     ap.add_argument("--width", type=float, default=None,
                     help="softplus width [mm] (default 1e-2 * 2.5 MPa / k: p(0) ~ 0.7 %% of p)")
     ap.add_argument("--predictor", nargs="+", default=["secant"], choices=["secant", "none"])
-    ap.add_argument("--quadrature", nargs="+", default=["gauss"], choices=["gauss", "vertex"])
+    ap.add_argument("--quadrature", nargs="+", default=["gauss"], choices=["gauss", "vertex", "nodal"],
+                    help="interface points: the Gauss rule's, the vertex rule's (P1), or the "
+                    "nodal point set through the Gauss rule (rough_contact.fem.nodal)")
     ap.add_argument("--reversal-stiffness", type=float, nargs="+", default=[1.0],
                     help="SoftplusPenalty.reversal_stiffness (0 = consistent tangent everywhere)")
     ap.add_argument("--augmented", type=int, nargs="+", default=[0], choices=[0, 1],

@@ -198,7 +198,7 @@ class ContactInterface(InterfaceQueries):
         self.quadrature, self.quadrature_degree = quadrature, degree
         n_owned = facet_connectivity(V.mesh)
         rule = FacetRule.create(V.mesh, degree, vertex=quadrature == "vertex")
-        if quadrature == "gauss":
+        if quadrature == "gauss" and self._constraints_per_point:
             warn_overconstrained(self.enforcement, rule.nq, V.mesh.topology.cell_type,
                                  compat.element_degree(V), degree)
         geo1 = FacetGeometry(V, owned_tagged_facets(facet_tags, first_tag, n_owned, self.comm))
@@ -219,13 +219,22 @@ class ContactInterface(InterfaceQueries):
         self._active = np.ones(self.paired.n_points, dtype=bool)
         self._anchor = self._start = None
         self._dirichlet = (None, list(bcs))
-        self._set_operator(JumpOperator(V, self.paired, bcs=bcs))
+        self._set_operator(self._point_set(ctx, bcs))
         n = self.n_points
         self.history = InterfaceHistory(initial_law_state(law, n, self.comm),
                                         self.enforcement.initial_multipliers(n))
         self._last = self._last_jump = self._newton_memo = None
         self._result_checked = False  # the first evaluation's result is checked in full
         self._softened = None         # (factor, law.softened(factor)) during a continuation
+
+    # the law is evaluated at the pairing's points (a subclass may aggregate them: the nodal
+    # point set of rough_contact.fem.nodal, whose constraints are not per quadrature point)
+    _constraints_per_point = True
+
+    def _point_set(self, ctx: SurfaceContext, bcs: Sequence) -> JumpOperator:
+        """The jump operator at the points the law is evaluated at (collective); here the
+        pairing's points themselves (``self.paired``)."""
+        return JumpOperator(ctx.V, self.paired, bcs=bcs)
 
     def _set_operator(self, operator: JumpOperator, jump0: Optional[np.ndarray] = None):
         self.operator = operator

@@ -30,6 +30,7 @@ from petsc4py import PETSc
 from rough_contact.fem.boundary import fix
 from rough_contact.fem.compat import element_degree, vector_space
 from rough_contact.fem.contact import ContactInterface
+from rough_contact.fem.nodal import NodalContactInterface
 from rough_contact.fem.mesh import Scene
 from rough_contact.fem.pairing import AutoPairing
 from rough_contact.fem.problem import ContactProblem, Material, SurfaceLoad
@@ -239,7 +240,7 @@ def build(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2, load_h
           dof_threshold=None, quadrature_degree=None, normal=None, seating_steps=None,
           cell_type="tetrahedron", *, punch_scene=None, total_force=TOTAL_FORCE,
           solver_defaults=None, quadrature="gauss", solver_options=None, enforcement=None,
-          kt_over_kn=None, pairing="auto"):
+          kt_over_kn=None, pairing="auto", points="quadrature"):
     """Mesh, law, interface, problem and solver of the quarter punch. Collective.
 
     ``pairing`` pairs the punch bottom with the foundation (``ContactInterface(pairing=)``):
@@ -252,6 +253,10 @@ def build(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2, load_h
 
     ``quadrature`` is the interface rule (``"gauss"`` of ``quadrature_degree``, default 2 x
     order, or ``"vertex"``: nodal, P1 only; see ``ContactInterface``).
+
+    ``points``: ``"quadrature"`` (the law at the rule's points) or ``"nodal"`` (at the
+    first surface's vertices on mortar-weighted jumps, any order:
+    :class:`rough_contact.fem.nodal.NodalContactInterface`).
 
     ``punch_scene`` reuses a :class:`PunchScene` of :func:`quarter_punch` (mesh sizes, order
     and cell type are then taken from it); ``total_force`` is the full punch's force at load
@@ -298,7 +303,10 @@ def build(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2, load_h
     qdeg = quadrature_degree if quadrature_degree is not None else default_qdeg(order)
     if isinstance(pairing, str) and pairing == "auto":   # non-matching: the patch-exact mortar
         pairing = AutoPairing(second, "mortar" if quadrature == "gauss" else None)
-    interface = ContactInterface(V, scene.facet_tags, first, second, law=interface_law,
+    if points not in ("quadrature", "nodal"):
+        raise ValueError(f"points = {points!r} is invalid: 'quadrature' or 'nodal'")
+    kind = NodalContactInterface if points == "nodal" else ContactInterface
+    interface = kind(V, scene.facet_tags, first, second, law=interface_law,
                                  grain_direction=GRAIN_X, quadrature_degree=qdeg,
                                  quadrature=quadrature, bcs=bcs, enforcement=enforcement,
                                  pairing=pairing)

@@ -29,6 +29,7 @@ from mpi4py import MPI
 from rough_contact.fem.boundary import fix
 from rough_contact.fem.compat import vector_space
 from rough_contact.fem.contact import ContactInterface
+from rough_contact.fem.nodal import NodalContactInterface
 from rough_contact.fem.problem import ContactProblem, Material, PrescribedDisplacement
 from rough_contact.fem.rigid import RigidSphere
 from rough_contact.interface.enforcement import AugmentedLagrangian, Penalty
@@ -132,8 +133,8 @@ def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5
         mu=0.3, penalty=INDENTER_PENALTY, half_width=4.0, height=4.0, mesh_size=1.0, preload_steps=2,
         shear_steps=12, cycles=0, indenter="paraboloid", quadrature_degree=None,
         k_tangential=None, ring_size=None, ring_band=(0.8, 1.05), width_ratio=1e-3,
-        augmented=False, augmentation_tolerance=1e-3, comm=MPI.COMM_WORLD,
-        verbose=False) -> MindlinRun:
+        augmented=False, augmentation_tolerance=1e-3, points="quadrature",
+        max_updates=30, comm=MPI.COMM_WORLD, verbose=False) -> MindlinRun:
     """Normal indentation by ``delta`` [mm], then a tangential bottom displacement: monotonic to
     ``slide`` [mm] (``cycles`` = 0) or ``cycles`` triangle cycles of amplitude ``slide``.
 
@@ -163,6 +164,11 @@ def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5
     ``augmented``: exact contact and stick by the augmented-Lagrangian (Uzawa) iteration of
     ``SoftplusPenalty`` with ``AugmentedLagrangian(augmentation_tolerance)``; the penalties then
     set only how fast the multipliers converge.
+
+    ``points``: ``"quadrature"`` (the law at the facet rule's points) or ``"nodal"`` (at the
+    vertices of the contact surface on mortar-weighted jumps,
+    :class:`rough_contact.fem.nodal.NodalContactInterface`: one constraint per surface vertex,
+    so exact stick does not lock on P2). ``max_updates``: multiplier updates per increment.
 
     ``slide`` defaults to the approach at which Mindlin's Q reaches mu P for Hertz's P at
     ``delta`` plus the block's shear compliance (so the last increments slide).
@@ -203,12 +209,16 @@ def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5
     check_scalar("k_tangential", k_tangential, lo=0.0, unit="MPa/mm")
     check_scalar("width_ratio", width_ratio, lo=0.0)
     law = SoftplusPenalty(penalty, width_ratio * delta, k_tangential=k_tangential, friction=mu)
-    enforcement = AugmentedLagrangian(augmentation_tolerance) if augmented else Penalty()
+    enforcement = AugmentedLagrangian(augmentation_tolerance, max_updates) if augmented \
+        else Penalty()
+    if points not in ("quadrature", "nodal"):
+        raise ValueError(f"points = {points!r} is invalid: 'quadrature' or 'nodal'")
     if indenter not in ("paraboloid", "sphere"):
         raise ValueError(f"indenter = {indenter!r} is invalid: 'paraboloid' or 'sphere'")
     rigid = ParaboloidIndenter(radius) if indenter == "paraboloid" else \
         RigidSphere((0.0, 0.0, radius), radius)
-    ci = ContactInterface(V, scene.facet_tags, scene.tag("contact"), law=law,
+    ci = (NodalContactInterface if points == "nodal" else ContactInterface)(
+                          V, scene.facet_tags, scene.tag("contact"), law=law,
                           rigid=rigid, bcs=[sym],
                           quadrature_degree=default_qdeg(order) if quadrature_degree is None
                           else quadrature_degree, grain_direction=GRAIN_X,

@@ -1,0 +1,59 @@
+"""Cattaneo–Mindlin with exact stick (rough_contact.scenes.mindlin, P2): one monotonic run, a
+table row per increment: P against Hertz at the same approach, Q/muP, the FE stick ratio
+against (1 - Q/muP)^(1/3), the dissipation, Newton iterations.
+
+    OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bench_exact_mindlin.py \\
+        [--points nodal|quadrature] [--plain] [--contact-size 0.05] [--shear-steps 6]
+        [--k-tangential 1e9] [--al-tol 1e-4] [--nu 0.49]
+
+Units: mm, N, MPa.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+from petsc4py import PETSc
+
+from rough_contact import references
+from rough_contact.scenes import mindlin
+
+E, R, DELTA = 2.0e5, 10.0, 4e-3
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--points", default="nodal", choices=["nodal", "quadrature"])
+    ap.add_argument("--plain", action="store_true", help="plain penalty (no augmentation)")
+    ap.add_argument("--contact-size", type=float, default=0.05)
+    ap.add_argument("--shear-steps", type=int, default=6)
+    ap.add_argument("--k-tangential", type=float, default=1e9,
+                    help="tangential penalty [MPa/mm]; with exact stick it sets only how fast "
+                    "the multipliers converge")
+    ap.add_argument("--al-tol", type=float, default=1e-4)
+    ap.add_argument("--nu", type=float, default=0.49)
+    ap.add_argument("--verbose", action="store_true")
+    args = ap.parse_args(argv)
+    t0 = time.perf_counter()
+    r = mindlin.run(contact_size=args.contact_size, order=2, nu=args.nu,
+                    shear_steps=args.shear_steps, augmented=not args.plain, points=args.points,
+                    augmentation_tolerance=args.al_tol, max_updates=60,
+                    k_tangential=args.k_tangential, verbose=args.verbose)
+    E_star = E / (1.0 - args.nu**2)
+    q = r.Q / (r.mu * r.P)
+    PETSc.Sys.Print(f"{'t':>6} {'P [N]':>8} {'P/Hertz-1':>9} {'Q/muP':>7} {'c/a FE':>7} "
+                    f"{'c/a MD':>7} {'error':>7} {'D [N mm]':>10} {'Newton':>6}")
+    for i in range(r.t.size):
+        delta = DELTA * min(r.t[i], 1.0)
+        hertz = references.hertz_force(delta, R, E_star)
+        ref = float(references.stick_ratio(min(abs(r.Q[i]), r.mu * r.P[i]), r.mu, r.P[i]))
+        PETSc.Sys.Print(f"{r.t[i]:6.3f} {r.P[i]:8.3f} {r.P[i] / hertz - 1:+9.4f} {q[i]:7.4f} "
+                        f"{r.stick[i]:7.4f} {ref:7.4f} {r.stick[i] / ref - 1:+7.4f} "
+                        f"{r.dissipation[i]:10.3e} {int(r.newton[i]):6d}")
+    PETSc.Sys.Print(f"DOFs {r.dofs}, {time.perf_counter() - t0:.0f} s")
+    return r
+
+
+if __name__ == "__main__":
+    main()

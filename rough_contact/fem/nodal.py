@@ -1,0 +1,307 @@
+"""Nodal (vertex) interface points obtained through the mortar integrals: exact contact and
+stick with no more constraints than the surface can carry, on any element order and pairing.
+
+An exact enforcement (``AugmentedLagrangian``) imposes its constraint at every point the law
+is evaluated at. At the quadrature points of a P2 facet (6 Gauss points of degree 4 for 6
+nodes, shared with the neighbours: about 4 times as many points as surface nodes) the
+constraints lock. This module evaluates the law at the VERTICES of the first surface instead,
+on jumps weighted by first-order vertex shape functions N_j (P1 on triangles, Q1 on
+quadrilaterals, also for P2/Q2 displacements):
+
+    m_j = sum_q w_q N_j(x_q),        g~_j = R_j (1/m_j) sum_q w_q N_j(x_q) R_q^T g_q,
+
+where q runs over the pairing's points (Gauss points of the conforming or rigid pairing, the
+pieces' points of the mortar pairing), w_q their area weights, R_q their frames, g_q = B_q u
++ g0_q their jumps, and R_j the vertex frame (normal: the normalised weighted normal
+sum_q w_q N_j n_q; x: the grain direction projected). The law gives t_j at g~_j, and the force
+m_j t_j goes back through the same rows: R_c = sum_j m_j B_j^T t_j with
+B_j = R_j (1/m_j) sum_q w_q N_j R_q^T B_q. A first-order multiplier space is stable for P2/Q2
+displacements and avoids the P2 triangle's corner functions of zero integral (which break a
+dual basis). Because the N_j are a partition of unity, a uniform traction gives exactly the
+quadrature route's residual: the patch test passes wherever the pairing passes it.
+
+Each vertex row combines the rows of all the vertex's facets (and their partners): one
+"group" per vertex with a variable number of DOFs, padded to the rank's largest count with
+zero columns whose matrix rows are skipped (-1). A vertex shared by facets on several ranks is
+assembled on the rank that owns its DOF (its global index): every rank sends its partial sums
+there once at set-up; a rank without contact facets is normal. A displacement component of
+the vertex fixed by a Dirichlet condition (a symmetry plane through it) is a mirror: the
+weighted jump and normal of its half patch get no component along that axis, as the full
+symmetric patch would have none. The penalty, the
+augmented-Lagrangian enforcement and the friction history then work unchanged on the vertex
+points.
+
+Units: mm, N, MPa.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Sequence
+
+import basix
+import numpy as np
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from rough_contact.fem.contact import ContactInterface
+from rough_contact.fem.jump import JumpOperator
+from rough_contact.fem.pairing.base import PairedPoints, SurfaceContext, local_frames
+from rough_contact.fem.pairing.facets import basix_cell
+
+__all__ = ["NodalContactInterface", "NodalPoints", "VertexJumpOperator", "nodal_points",
+           "vertex_shape_matrix"]
+
+
+@dataclass(frozen=True)
+class NodalPoints:
+    """The vertex points of this rank (the vertices whose DOF it owns).
+
+    Attributes:
+        vertex: (n_v,) global block index of each vertex's DOF (ascending).
+        x: (n_v, 3) vertex coordinates [mm].
+        weights: (n_v,) m_j = int N_j dA over the first surface [mm^2].
+        frames: (n_v, 3, 3) local axes, rows n, x, y in global components.
+        jump0: (n_v, 3) jump at zero displacement [mm].
+        B: (n_v, 3, 3 m) rows of the weighted jump on the vertex's DOFs.
+        nodes: (n_v, m) global block indices of those DOFs (padded with the first node).
+        pad: (n_v, m) True for padding columns (B = 0 there).
+    """
+
+    vertex: np.ndarray
+    x: np.ndarray
+    weights: np.ndarray
+    frames: np.ndarray
+    jump0: np.ndarray
+    B: np.ndarray
+    nodes: np.ndarray
+    pad: np.ndarray
+
+
+def vertex_shape_matrix(V) -> tuple[np.ndarray, np.ndarray]:
+    """First-order vertex functions in terms of the facet-closure basis of V.
+
+    Returns:
+        M: (n_lf, n_close, nv): M[lf, k, i] = value of the P1/Q1 function of the facet's vertex
+            i at the node of closure DOF k, so that N_i = sum_k M[lf, k, i] phi_k exactly (the
+            first-order space lies in V's space; for P1/Q1, M is a selection).
+        vertex_closure: (n_lf, nv) closure index of each facet vertex's DOF.
+    """
+    element = V.element.basix_element
+    cell = basix_cell(V.mesh)
+    p1 = basix.create_element(basix.ElementFamily.P, cell, 1)
+    closure = np.array(element.entity_closure_dofs[2])        # (n_lf, n_close)
+    facet_vertices = np.array(basix.topology(cell)[2])        # (n_lf, nv)
+    n_lf, n_close = closure.shape
+    X = np.asarray(element.points)[closure].reshape(-1, 3)
+    tab = np.asarray(p1.tabulate(0, X)[0]).reshape(n_lf, n_close, p1.dim)
+    M = np.take_along_axis(tab, facet_vertices[:, None, :], axis=2)
+    M[np.abs(M) < 1e-12] = 0.0
+    vertex_closure = np.argmax(M, axis=1)
+    if not np.allclose(np.take_along_axis(M, vertex_closure[:, None, :], axis=1), 1.0):
+        raise ValueError("the displacement element has no DOF at every facet vertex; the "
+                         "nodal point set needs a Lagrange space of degree 1 or 2")
+    return M, vertex_closure
+
+
+def nodal_points(ctx: SurfaceContext, paired: PairedPoints, op: JumpOperator) -> NodalPoints:
+    """The vertex points of the first surface from the pairing's points (collective).
+
+    Args:
+        ctx: the first surface; paired: the pairing's points; op: their jump operator (its
+            per-point rows and the DOFs of its groups; Dirichlet rows are not used).
+
+    Raises:
+        ValueError (every rank): a vertex with zero weight.
+    """
+    V, comm = ctx.V, ctx.comm
+    M, vclose = vertex_shape_matrix(V)
+    lf = ctx.geo1.local_facet
+    n_f, nq = paired.facets.size, paired.n_qp
+    nv = M.shape[2]
+    Nv = np.einsum("fqk,fkv->fqv", paired.N1, M[lf])                  # (n_f, nq, nv)
+    vid = np.take_along_axis(paired.nodes1, vclose[lf], axis=1)       # (n_f, nv)
+    c = paired.weights.reshape(n_f, nq, 1) * Nv                       # w_q N_j(x_q)
+    R = paired.frames.reshape(n_f, nq, 3, 3)
+    jump0 = paired.jump0.copy()
+    jump0[:, 0] += op.gap0
+    # per (facet, vertex): weight, weighted normal, weighted initial jump (global components)
+    m_fv = c.sum(axis=1)
+    n_fv = np.einsum("fqv,fqi->fvi", c, R[:, :, 0, :])
+    j0_fv = np.einsum("fqv,fqai,fqa->fvi", c, R, jump0.reshape(n_f, nq, 3))
+    # per (group, vertex): the weighted rows sum_q c R_q^T B_q on the group's DOFs
+    n_g, nqs, nd = op.n_groups, op.nqs, op._B.shape[2]
+    own = np.flatnonzero(op.own_slot)
+    slot = op._point_slot[own]
+    cs = np.zeros((n_g * nqs, nv))
+    cs[slot] = c.reshape(-1, nv)[own]
+    Rs = np.zeros((n_g * nqs, 3, 3))
+    Rs[slot] = paired.frames[own]
+    Bg = np.einsum("sai,sad->sid", Rs, op._B).reshape(n_g, nqs, 3, nd)
+    G = np.einsum("gsv,gsid->gvid", cs.reshape(n_g, nqs, nv), Bg)     # (n_g, nv, 3, nd)
+    group_facet = np.zeros(n_g, dtype=np.int64)
+    group_facet[slot // nqs] = own // nq
+    nn = nd // 3
+    group_nodes = op._pair_dofs[:, ::3] // 3                           # (n_g, nn), ascending
+    t_vid = np.repeat(vid[group_facet], nn, axis=1).reshape(-1)       # (n_g * nv * nn,)
+    t_node = np.broadcast_to(group_nodes[:, None, :], (n_g, nv, nn)).reshape(-1)
+    t_val = G.reshape(n_g, nv, 3, nn, 3).transpose(0, 1, 3, 2, 4).reshape(-1, 3, 3)
+    # components of the vertex's own displacement fixed by a Dirichlet condition (rows -1 of
+    # the quadrature operator): a symmetry plane through the vertex, mirrored below
+    m_keys = 3 * V.dofmap.index_map.size_global
+    flat = (np.arange(n_g)[:, None] * m_keys + op._pair_dofs).reshape(-1)
+    own_dofs = (np.arange(n_g)[:, None, None] * m_keys + 3 * vid[group_facet][:, :, None]
+                + np.arange(3))
+    pos = np.minimum(np.searchsorted(flat, own_dofs), max(flat.size - 1, 0))
+    f_fixed = (op._rows.reshape(-1)[pos] < 0) if flat.size else np.zeros((0, nv, 3), bool)
+    f_vid = vid[group_facet].reshape(-1)
+    f_fixed = f_fixed.reshape(-1, 3)
+    keep = np.any(t_val != 0.0, axis=(1, 2))
+    t_vid, t_node, t_val = t_vid[keep], t_node[keep], t_val[keep]
+    # send everything to the rank owning the vertex's DOF
+    imap = V.dofmap.index_map
+    r0 = imap.local_range[0]
+    ranges = np.array(comm.allgather(r0) + [imap.size_global])
+    dest_v = np.searchsorted(ranges, vid.reshape(-1), side="right") - 1
+    dest_t = np.searchsorted(ranges, t_vid, side="right") - 1
+    a_vals = np.concatenate([vid.reshape(-1, 1).astype(float), m_fv.reshape(-1, 1),
+                             n_fv.reshape(-1, 3), j0_fv.reshape(-1, 3)], axis=1)
+    dest_f = np.searchsorted(ranges, f_vid, side="right") - 1
+    send = [(a_vals[dest_v == r], t_vid[dest_t == r], t_node[dest_t == r], t_val[dest_t == r],
+             f_vid[dest_f == r], f_fixed[dest_f == r]) for r in range(comm.size)]
+    recv = comm.alltoall(send)
+    a_vals = np.concatenate([r[0] for r in recv])
+    a_vid = a_vals[:, 0].astype(np.int64)
+    t_vid = np.concatenate([r[1] for r in recv]).astype(np.int64)
+    t_node = np.concatenate([r[2] for r in recv]).astype(np.int64)
+    t_val = np.concatenate([r[3] for r in recv]).reshape(-1, 3, 3)
+    f_vid = np.concatenate([r[4] for r in recv]).astype(np.int64)
+    f_fixed = np.concatenate([r[5] for r in recv]).reshape(-1, 3)
+    verts, iv = np.unique(a_vid, return_inverse=True)
+    n_v = verts.size
+    m = np.bincount(iv, weights=a_vals[:, 1], minlength=n_v)
+    sums = np.stack([np.bincount(iv, weights=a_vals[:, k], minlength=n_v)
+                     for k in range(2, 8)], axis=1) if n_v else np.zeros((0, 6))
+    n_bad = comm.allreduce(int(np.sum(m <= 0.0)), op=MPI.SUM)
+    if n_bad:
+        raise ValueError(f"{n_bad} vertices of contact surface {ctx.first_tag} have weight "
+                         "int N_j dA <= 0; the nodal point set needs positive vertex weights")
+    n_glob = imap.size_global
+    key = np.searchsorted(verts, t_vid) * n_glob + t_node
+    ukey, inv = np.unique(key, return_inverse=True)
+    vals = np.stack([np.bincount(inv, weights=t_val.reshape(-1, 9)[:, k], minlength=ukey.size)
+                     for k in range(9)], axis=1).reshape(-1, 3, 3) if ukey.size else \
+        np.zeros((0, 3, 3))
+    kv, kn = ukey // n_glob, ukey % n_glob
+    counts = np.bincount(kv, minlength=n_v)
+    width = int(counts.max(initial=1))
+    starts = np.cumsum(counts) - counts
+    col = np.arange(ukey.size) - starts[kv]
+    A = np.zeros((n_v, 3, width, 3))
+    A[kv, :, col, :] = vals
+    nodes = np.empty((n_v, width), dtype=np.int64)
+    nodes[:] = kn[starts][:, None] if n_v else 0
+    nodes[kv, col] = kn
+    pad = np.ones((n_v, width), dtype=bool)
+    pad[kv, col] = False
+    # a component fixed at the vertex is a mirror plane: the vertex's patch is half of a
+    # symmetric one whose weighted jump and normal have no component along it
+    hits = np.zeros((n_v, 3))
+    np.add.at(hits, np.searchsorted(verts, f_vid), f_fixed.astype(float))
+    fixed = hits > 0.0
+    A[fixed] = 0.0
+    sums[:, :3][fixed] = 0.0
+    sums[:, 3:][fixed] = 0.0
+    # vertex frames and coordinates
+    normal = sums[:, :3] / np.maximum(np.linalg.norm(sums[:, :3], axis=1), 1e-300)[:, None]
+    x = V.tabulate_dof_coordinates()[(verts - r0).astype(np.int64)].reshape(n_v, 3)
+    frames, _ = local_frames(comm, x, normal, ctx.grain)
+    B = np.einsum("vai,vikc->vakc", frames, A).reshape(n_v, 3, 3 * width) / m[:, None, None]
+    j0 = np.einsum("vai,vi->va", frames, sums[:, 3:]) / m[:, None]
+    return NodalPoints(vertex=verts, x=x, weights=m, frames=frames, jump0=j0, B=B,
+                       nodes=nodes, pad=pad)
+
+
+class VertexJumpOperator(JumpOperator):
+    """The jump operator at the vertex points: one group per vertex (one point slot), its DOFs
+    the union of those of its facets and their partners, padded with zero columns.
+
+    Args:
+        V: the displacement space; nodal: the vertex points; bcs, global_dofs: Dirichlet DOFs
+            (``JumpOperator.set_dirichlet_dofs``).
+    """
+
+    def __init__(self, V, nodal: NodalPoints, bcs: Sequence = (), global_dofs=None):
+        self.V = V
+        self.comm = V.mesh.comm
+        n_v, _, nd = nodal.B.shape
+        self.gap0 = np.zeros(n_v)
+        self.keys = None
+        self.n_remote_partners = 0
+        self.n_groups, self.nqs = n_v, 1
+        self._B = np.ascontiguousarray(nodal.B)
+        self._Bf = self._B
+        self._BfT = np.ascontiguousarray(np.swapaxes(self._B, 1, 2))
+        self._point_slot = np.arange(n_v, dtype=np.int64)
+        self.own_slot = np.ones(n_v, dtype=bool)
+        self._identity_slots = True
+        self.pair_nodes = nodal.nodes
+        self._pair_dofs = (3 * nodal.nodes[:, :, None] + np.arange(3)).reshape(n_v, nd)
+        self._pad = np.repeat(nodal.pad, 3, axis=1)
+        self.n_points = n_v
+        self._communication()
+        self.set_dirichlet_dofs(global_dofs, bcs)
+
+    def set_dirichlet_dofs(self, global_dofs=None, bcs: Sequence = ()) -> None:
+        """As ``JumpOperator.set_dirichlet_dofs``; padding columns are never assembled."""
+        super().set_dirichlet_dofs(global_dofs, bcs)
+        rows = np.array(self._rows)
+        rows[self._pad] = -1
+        self._rows = rows.astype(PETSc.IntType)
+
+
+class NodalContactInterface(ContactInterface):
+    """:class:`~rough_contact.fem.contact.ContactInterface` whose law is evaluated at the
+    vertices of the first surface on mortar-weighted jumps (module docstring): one point, one
+    constraint per surface vertex, so ``AugmentedLagrangian`` gives exact contact and stick
+    without locking on P1, P2, Q1 and Q2, with the conforming, mortar, projection and rigid
+    pairings. Same arguments as ``ContactInterface``; ``quadrature_degree`` sets the rule the
+    vertex integrals are computed with (the pairing's points). Small sliding only.
+
+    Per-point queries (``point_fields``, ``weights``, ``frames``, ``points``) are per vertex
+    (weights m_j, which sum to the nominal area); the per-facet output
+    (``rough_contact.io.interface_output``) is not available on vertex points.
+
+    Attributes (besides ``ContactInterface``'s):
+        quadrature_points: the pairing's points the vertex integrals were computed from.
+        nodal: the :class:`NodalPoints` of this rank.
+
+    Raises:
+        ValueError: ``sliding`` other than ``"small"`` (the vertex rows are built once).
+    """
+
+    _constraints_per_point = False
+
+    def __init__(self, V, facet_tags, first_tag, second_tag=None, **kwargs):
+        sliding = kwargs.get("sliding", "small")
+        if sliding != "small":
+            raise ValueError(f"sliding = {sliding!r} is invalid for the nodal point set: only "
+                             "'small' (the vertex rows are built once at set-up)")
+        super().__init__(V, facet_tags, first_tag, second_tag, **kwargs)
+
+    def _point_set(self, ctx: SurfaceContext, bcs: Sequence) -> JumpOperator:
+        quad = JumpOperator(ctx.V, self.paired, bcs=bcs)
+        self.quadrature_points = self.paired
+        self.nodal = nodal_points(ctx, self.paired, quad)
+        nodal = self.nodal
+        n_v = nodal.vertex.size
+        self.paired = PairedPoints(
+            facets=np.zeros(0, dtype=np.int32), n_qp=1, x=nodal.x, weights=nodal.weights,
+            frames=nodal.frames, jump0=nodal.jump0, N1=np.zeros((n_v, 1, 0)),
+            nodes1=nodal.vertex[:, None], partners=None, name="nodal")
+        return VertexJumpOperator(ctx.V, nodal, bcs=bcs)
+
+    def describe(self) -> dict:
+        """``ContactInterface.describe`` plus the point set (a checkpoint of the quadrature
+        route is not resumed on vertex points, nor the other way round)."""
+        return dict(super().describe(), points="nodal")
