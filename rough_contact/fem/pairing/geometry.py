@@ -154,10 +154,7 @@ def project_points_from(previous: np.ndarray, x: np.ndarray, normal: np.ndarray,
             again = _candidates(x[retry], normal[retry], surface,
                                 _nearest(tree, x[retry], 1 if group == "nearest" else 4), cmap,
                                 search_radius, inside_tol, max_iter)
-        merged = [getattr(result, f).copy() for f in Projection.__dataclass_fields__]
-        for arr, new in zip(merged, (getattr(again, f) for f in Projection.__dataclass_fields__)):
-            arr[retry] = new
-        result = Projection(*merged)
+        result = _replaced(result, retry, again)
     return result
 
 
@@ -243,11 +240,16 @@ def _project(x, normal, surface, cmap, search_radius, n_candidates, inside_tol, 
             break
         again = _candidates(x[retry], normal[retry], surface, finder(x[retry]), cmap,
                             search_radius, inside_tol, max_iter)
-        merged = [getattr(result, f).copy() for f in Projection.__dataclass_fields__]
-        for arr, new in zip(merged, (getattr(again, f) for f in Projection.__dataclass_fields__)):
-            arr[retry] = new
-        result = Projection(*merged)
+        result = _replaced(result, retry, again)
     return result
+
+
+def _replaced(result: "Projection", rows: np.ndarray, again: "Projection") -> "Projection":
+    """``result`` with the points ``rows`` replaced by ``again`` (a projection of those points)."""
+    merged = [getattr(result, f).copy() for f in Projection.__dataclass_fields__]
+    for arr, new in zip(merged, (getattr(again, f) for f in Projection.__dataclass_fields__)):
+        arr[rows] = new
+    return Projection(*merged)
 
 
 def _nearest(tree, x, k):
