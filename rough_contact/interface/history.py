@@ -348,7 +348,7 @@ class HistoryNormalLaw:
         cache: dict = {}
         n_pts = [0]
         n_capped = [0]
-        _CAP_WORST[0] = 0.0
+        cap_worst = [0.0]               # largest ln(p_unload / p_load(h)) met (the warning)
 
         def model(hms, xs):
             """(rho, d rho/dx, ln a - ln a0, d ln a/dx) (4, len(hms), len(xs)), cached per
@@ -368,7 +368,7 @@ class HistoryNormalLaw:
                     vals = np.stack([np.log(p[1:] / p[0]), -k[1:] / p[1:] * sig,
                                      np.log(a[1:] / a[0]), -da[1:] / a[1:] * sig])
                     n_capped[0] += _count_above_loading(vals[0], loading, float(hm), uu[1:],
-                                                        rtol, tail)
+                                                        rtol, tail, worst=cap_worst)
                     for x, col in zip(need, vals.T):
                         row[round(float(x), 12)] = tuple(float(c) for c in col)
                 for j, x in enumerate(xs):
@@ -450,7 +450,7 @@ class HistoryNormalLaw:
             warnings.warn(
                 f"HistoryNormalLaw: the summits' unloading sums exceed the loading law at "
                 f"{n_capped[0]} of {n_pts[0]} table points (up to a factor "
-                f"{math.exp(_CAP_WORST[0]):.4g}): with these yield data one summit's load jumps "
+                f"{math.exp(cap_worst[0]):.4g}): with these yield data one summit's load jumps "
                 f"up where it starts to yield (Zhao-Maietta-Chang at omega_c above the Hertz "
                 f"load), and its elastic unloading from the jump would return more work than "
                 f"the loading took. The unloading branch is capped by the loading branch "
@@ -670,24 +670,22 @@ class UnloadingAboveLoadingWarning(UserWarning):
     """The direct sums put an unloading branch above the loading one (capped by it)."""
 
 
-_CAP_WORST = [0.0]      # largest ln(p_unload / p_load(h)) met by the last build (its warning)
 
 
-def _count_above_loading(rho, loading, h_min, u, rtol, tail=1e-12) -> int:
+def _count_above_loading(rho, loading, h_min, u, rtol, tail=1e-12, worst=None) -> int:
     """Number of one row's points (rho at u = h - h_min [mm]) where the direct sums put the
     unloading branch above the loading branch, ln p_u/p_load(h) > rtol (below rtol the sums
     and the loading table agree to their accuracy, e.g. on rows where nothing has yielded),
     among the points where both branches are above ``tail`` p_load(h_min) and h is inside the
-    loading table (beyond it the loading law's taper ends at its h_max while the sums go on);
-    records the largest excess
-    for the build's warning."""
+    loading table (beyond it the loading law's taper ends at its h_max while the sums go on).
+    The largest excess goes into ``worst[0]`` (a one-element list of the build) if given."""
     pl = loading.evaluate(np.concatenate([[h_min], h_min + np.asarray(u, float)]))[0]
     r_load = np.log(np.maximum(pl[1:], 1e-300) / max(pl[0], 1e-300))
     use = ((r_load >= math.log(tail)) & (np.asarray(rho) >= math.log(tail))
            & (h_min + np.asarray(u, float) < loading.h_table_end))
     excess = (np.asarray(rho) - r_load)[use]
-    if excess.size:
-        _CAP_WORST[0] = max(_CAP_WORST[0], float(excess.max()))
+    if excess.size and worst is not None:
+        worst[0] = max(worst[0], float(excess.max()))
     return int(np.count_nonzero(excess > rtol))
 
 
