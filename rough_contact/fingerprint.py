@@ -4,10 +4,11 @@ restart into another law, pairing, enforcement or load program is refused, namin
 A description is plain JSON data, identical on every rank and in every process for the same
 parameters:
 
-* a float is written as its ``repr`` (a string), so two values compare exactly as written
-  (0.3 and 0.30000000000000004 differ); ints, bools, strings and None stay as they are;
+* a float is written as its ``repr`` (a string); ints, bools, strings and None stay as they are;
 * an array of at most :data:`SMALL_ARRAY` entries is the list of its values (floats as above);
-  a larger one is ``{"array": dtype, "shape": ..., "sha256": ...}`` of its bytes;
+  a larger one is ``{"array": dtype, "shape": ..., "sha256": ..., "sketch": ...}``: the hash
+  of its bytes and, for a finite float array, a sketch -- sum |a| and three projections on fixed
+  pseudo-random weights;
 * a frozen dataclass (the house style for laws, enforcements, pairings) is
   ``{"type": module.qualname, field: description, ...}`` over its fields; a field declared
   ``field(compare=False)`` is not part of its identity and is left out (e.g. build statistics);
@@ -17,7 +18,12 @@ parameters:
   :class:`UndescribedWarning` says that a restart cannot check its parameters.
 
 :func:`differences` compares two descriptions and names every differing entry by its path
-(``friction.mu_macro[0]: 0.5 in the checkpoint, 0.2 now``).
+(``friction.mu_macro[0]: 0.5 in the checkpoint, 0.2 now``). Floats are compared to a relative
+:data:`FLOAT_RTOL`, float arrays by their hash or else by their sketches to :data:`ARRAY_RTOL`
+of sum |a|: the same table built in another process can differ in its last bits (OpenBLAS's
+matrix-vector kernels round differently on 8- and 16-byte aligned data, so a law table built
+twice from the same inputs is not always bit-identical), and a restart must not be refused for
+that; a table built from other inputs differs by far more.
 
 Pure Python + numpy (no FE import).
 """
@@ -32,9 +38,13 @@ from typing import Any, List, Protocol, runtime_checkable
 
 import numpy as np
 
-__all__ = ["Describable", "UndescribedWarning", "describe", "differences", "SMALL_ARRAY"]
+__all__ = ["Describable", "UndescribedWarning", "describe", "differences", "SMALL_ARRAY",
+           "FLOAT_RTOL", "ARRAY_RTOL"]
 
 SMALL_ARRAY = 16   # arrays up to this size are written out value by value
+FLOAT_RTOL = 1e-12  # two floats closer than this (relative) are the same parameter
+ARRAY_RTOL = 1e-10  # two float arrays whose sketches agree to this (of sum |a|) are the same
+_SKETCH_SEED = 20090424
 
 
 class UndescribedWarning(RuntimeWarning):
@@ -65,8 +75,35 @@ def _array(a: np.ndarray, path: str):
     if a.size <= SMALL_ARRAY and a.ndim <= 1:
         return [describe(v.item(), f"{path}[{i}]") for i, v in enumerate(a.reshape(-1))]
     data = np.ascontiguousarray(a)
-    return {"array": str(data.dtype), "shape": list(data.shape),
-            "sha256": hashlib.sha256(data.tobytes()).hexdigest()}
+    out = {"array": str(data.dtype), "shape": list(data.shape),
+           "sha256": hashlib.sha256(data.tobytes()).hexdigest()}
+    if np.issubdtype(data.dtype, np.floating) and np.isfinite(data).all():
+        flat = data.reshape(-1).astype(float)
+        w = np.random.default_rng(_SKETCH_SEED).uniform(-1.0, 1.0, (3, flat.size))
+        out["sketch"] = [_float(np.abs(flat).sum())] + [_float(v) for v in (w * flat).sum(axis=1)]
+    return out
+
+
+def _same(x: Any, y: Any) -> bool:
+    """Two flattened description entries are the same parameter (see the module)."""
+    if x == y:
+        return True
+    if isinstance(x, dict) and isinstance(y, dict):       # arrays whose hashes differ
+        sx, sy = x.get("sketch"), y.get("sketch")
+        if (x.get("array"), x.get("shape")) != (y.get("array"), y.get("shape")) or not sx or not sy:
+            return False
+        fx, fy = np.array(sx, float), np.array(sy, float)
+        scale = max(fx[0], fy[0])
+        return bool(np.all(np.abs(fx - fy) <= ARRAY_RTOL * scale))
+    if isinstance(x, str) and isinstance(y, str):         # floats written as repr
+        try:
+            fx, fy = float(x), float(y)
+        except ValueError:
+            return False
+        if not (np.isfinite(fx) and np.isfinite(fy)):
+            return False
+        return abs(fx - fy) <= FLOAT_RTOL * max(abs(fx), abs(fy))
+    return False
 
 
 def _function(fn, path: str) -> dict:
@@ -148,7 +185,7 @@ def differences(saved: Any, now: Any, limit: int = 8) -> List[str]:
     a, b = {}, {}
     _flatten(saved, "", a)
     _flatten(now, "", b)
-    keys = [k for k in list(a) + [k for k in b if k not in a] if a.get(k) != b.get(k)]
+    keys = [k for k in list(a) + [k for k in b if k not in a] if not _same(a.get(k), b.get(k))]
     lengths = {k[:-4] for k in keys if k.endswith("#len")}
     # a list of another length: say so once instead of listing every shifted entry
     keys = [k for k in keys if k.endswith("#len")
