@@ -25,8 +25,9 @@ a largest interference omega_max with load P_m = P(omega_max) and area A_m = A(o
   kappa_r = f1 pi delta_e/A_m. For omega_max <= omega_c this gives delta_e = omega_max,
   omega_res = 0 exactly: the elastic summit is reversible. delta_e is clipped to omega_max
   (omega_res >= 0).
-* optional ``residual="ekk"``: omega_res from the Etsion-Kligerman-Kadin (2005) sphere fit
-  (see :func:`ekk_residual_ratio`; coefficients recalled, NOT verified against the paper).
+* optional ``residual="ekk"``: omega_res from a sphere fit attributed to Etsion-Kligerman-Kadin
+  (2005) (see :func:`ekk_residual_ratio`: coefficients recalled, NOT verified against the
+  paper, and most likely a garbled Jackson-Chusoipin-Green fit; provisional).
 * reloading (omega_res < omega <= omega_max) follows the same elastic curve; beyond omega_max
   the loading branch, and omega_max grows.
 
@@ -48,7 +49,7 @@ from .asperity import (AsperityMaterial, critical_interference, shape_factors, z
                        zmc_mean_pressure)
 
 __all__ = ["summit_loading", "recovered_interference", "summit_unloading", "ekk_residual_ratio",
-           "population_unloading"]
+           "jcg_residual_ratio", "population_unloading"]
 
 _RESIDUAL = ("consistent", "ekk")
 
@@ -85,21 +86,44 @@ def _delta_e(W, A, P, f1, f2, Es):
     return np.minimum(de, W)
 
 
+def _omega_star(omega_max_star, name="omega_max_star"):
+    w = np.asarray(omega_max_star, dtype=float)
+    if np.any(~np.isfinite(w) | (w < 0)):
+        raise ValueError(f"{name} = {omega_max_star!r} (omega_max/omega_c) is invalid: "
+                         "valid range [0, inf)")
+    return w
+
+
 def ekk_residual_ratio(omega_max_star):
     """omega_res/omega_max after unloading a sphere from omega_max_star = omega_max/omega_c.
 
-    The Etsion-Kligerman-Kadin (2005) fit in the form
-    1.02 [1 - (w* + 5.9)^(-0.54)] [1 - (w*)^(-0.14)] for w* >= 1 (0 below), stated by its
-    authors for 1 <= w* <= 110 (their loading law: Kogut-Etsion, elastic-linear-hardening FE).
-    The coefficients are the form as recalled: the paper's text could not be retrieved to check
-    them (docs/unloading.md says what was checked and what is uncertain); the option is
-    provisional. Elliptic summits: w* uses the summit's own omega_c, and the ratio is taken as
-    the sphere's at the same w* (reading stated in docs/unloading.md).
+    PROVISIONAL, NOT the verified Etsion-Kligerman-Kadin (2005) fit. The form evaluated is
+    1.02 [1 - (w* + 5.9)^(-0.54)] [1 - (w*)^(-0.14)] for w* >= 1 (0 below), as recalled when
+    the option was written. The EKK paper's text could not be retrieved to check it. Its first
+    factor carries the constants 1.02, 5.9 and -0.54 of the Jackson-Chusoipin-Green (2005) fit
+    (:func:`jcg_residual_ratio`, 1.02 [1 - ((w* + 5.9)/6.9)^(-0.54)]) without JCG's
+    normalisation by 6.9, so the recalled form is most likely a garbled JCG fit attributed to
+    EKK (docs/unloading_literature.md). Kept unchanged (no verified replacement) for the
+    provisional option residual="ekk" only. Elliptic summits: w* uses the summit's own
+    omega_c, and the ratio is taken as the sphere's at the same w* (docs/unloading.md).
     """
-    w = np.asarray(omega_max_star, dtype=float)
+    w = _omega_star(omega_max_star)
     ws = np.maximum(w, 1.0)
     r = 1.02 * (1.0 - (ws + 5.9) ** -0.54) * (1.0 - ws ** -0.14)
     return np.where(w <= 1.0, 0.0, np.clip(r, 0.0, 1.0))
+
+
+def jcg_residual_ratio(omega_max_star):
+    """Jackson-Chusoipin-Green (2005) residual interference of a hemisphere (comparison only).
+
+    omega_res/omega_max = 1.02 [1 - ((w* + 5.9)/6.9)^(-0.54)], w* = omega_max/omega_c >= 1
+    (0 below: elastic, reversible); J. Tribol. 127 (2005) 484, elastic-perfectly plastic FE,
+    omega_c of Jackson-Green (C = 1.295 exp(0.736 nu)). Read from a public implementation, not
+    from the paper (docs/unloading_literature.md). Not used by any law of this package.
+    """
+    w = _omega_star(omega_max_star)
+    ws = np.maximum(w, 1.0)
+    return np.where(w <= 1.0, 0.0, 1.02 * (1.0 - ((ws + 5.9) / 6.9) ** -0.54))
 
 
 def _resolve(kappa_m, e1, material, elliptic):
