@@ -91,7 +91,9 @@ def test_sphere_limit_against_ekk_fit():
     """Sphere limit: omega_res/omega_max of the consistent construction (ZMC loading of the
     paper, K_Y Y = (2/pi) H) against the Etsion-Kligerman-Kadin (2005) residual-interference
     fit 1.02[1-(w*+5.9)^-0.54][1-(w*)^-0.14] as implemented in ekk_residual_ratio. SOURCE
-    CAVEAT: those coefficients are quoted from memory; the paper text was not available here.
+    CAVEAT: those coefficients are quoted from memory; the paper text was not available here,
+    and the form is most likely a garbled Jackson-Chusoipin-Green fit
+    (docs/unloading_literature.md; the JCG fit itself is checked in test_unloading_ekk.py).
     Fit values: w* = 10 -> 0.218, 45 -> 0.371, 110 -> 0.454. Measured (consistent
     construction): 0.42, 0.52, 0.69 (printed by bench_unloading). Only the order of magnitude
     and the trend are asserted: the loading laws differ (ZMC vs Kogut-Etsion), and EKK's
