@@ -207,6 +207,8 @@ def _p_windows(l, k, window_tol=0.0):
     """
     l = np.asarray(l, dtype=float)
     k = np.broadcast_to(np.asarray(k, dtype=float), l.shape)   # a scalar or one per l
+    if l.size == 0:
+        return np.zeros(l.shape), np.zeros(l.shape)
     l2, k2 = np.concatenate([l, l]), np.concatenate([k, k])
 
     log_F1 = (lambda d: log_F_n(1.0, d)) if window_tol <= 0.0 else _log_F1_closed

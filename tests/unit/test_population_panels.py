@@ -108,3 +108,12 @@ def test_elastic_sums_on_the_same_nodes_equal_the_all_node_evaluation():
         assert _rel(getattr(ep, f), ref[f]) < 1e-12, f
     for got, want in ((el.area_fraction, A), (el.pressure, W), (el.stiffness, K)):
         assert _rel(got, want) < 1e-12
+
+
+@pytest.mark.parametrize("window_tol", [0.0, 1e-3])
+def test_no_separations_give_empty_sums(window_tol):
+    mat = AsperityMaterial(E_star=1.14e5, psi=1.0)
+    ep, el = pop.elasto_plastic_and_elastic(S1, mat, np.zeros((0, 2)), window_tol=window_tol)
+    for r in (ep, el, pop.elasto_plastic(S1, mat, [])):
+        assert r.pressure.size == r.stiffness.size == r.area_fraction.size == 0
+    assert ep.pressure.shape == el.stiffness.shape == (0, 2)
