@@ -427,7 +427,7 @@ def elasto_plastic_and_elastic(surface: SpectralMoments, material: AsperityMater
 
 _EP_KEYS = ("Ae", "At", "Ap", "We", "Wt", "Wp", "K")
 _PQ_BUDGET = 100_000    # (h, p, q) nodes per chunk of separations (4 t panels each)
-_PANEL_BLOCK = 4096     # t panels per block of the inner sums (~64k nodes: stays in cache)
+_PANEL_BLOCK = 4096     # t panels per block of the inner sums (~65k nodes, 0.5 MB per array)
 _LOG_SQRT_2PI = 0.5 * math.log(2 * math.pi)
 
 
@@ -454,7 +454,7 @@ def _panel_moments(a, b, d, u, w):
     return M
 
 
-def _transition_sums(a, b, d, u, w, smu, f1, f3, c_area, wc, wp, R, chH, slope):
+def _transition_sums(a, b, u, w, smu, R, chH, slope, d, f1, f3, c_area, wc, wp):
     """sum_t wt (A, W, -dW/domega) of the ZMC transition (75)-(77) over the t panels [a, b]."""
     out = np.empty((3, a.size))
     for s in range(0, a.size, _PANEL_BLOCK):
@@ -502,8 +502,9 @@ def _elasto_plastic(surface, material, h, n_quad, elliptic, eccentricity, n_t, e
     # 1.5x more nodes along p: in deep contact the elastic/transition boundary of the flat
     # (small-p) asperities is a narrow feature in p (measured: 2e-4 -> 2e-5 at h = -5 sigma)
     n_p = (3 * n_quad) // 2
-    # the p windows of all separations in one vectorised search (elementwise: the same windows
-    # as one search per chunk, at fewer calls)
+    # the p windows of all separations in one vectorised search: fewer calls than one search
+    # per chunk, and with window_tol = 0 (to the fixed point, elementwise) the same windows;
+    # with window_tol > 0 the search stops on the widest bracket of the call
     windows = _p_windows(l, math.sqrt(surface.beta1 + surface.beta2) / math.sqrt(surface.mu),
                          window_tol)
     n_pq = 3 * n_p * 3 * n_quad
@@ -546,10 +547,9 @@ def _elasto_plastic(surface, material, h, n_quad, elliptic, eccentricity, n_t, e
         sel = live if elastic_too else live & (el | pl)
         idx = np.flatnonzero(sel)
         node = idx // 4                            # the (h, p, q) node of each panel (flat)
-        P = lambda x: x.ravel()[node]  # noqa: E731
-        M = _panel_moments(a.ravel()[idx], b.ravel()[idx], P(d), u, w)
+        M = _panel_moments(a.ravel()[idx], b.ravel()[idx], d.ravel()[node], u, w)
         is_el, is_pl = el.ravel()[idx], pl.ravel()[idx]
-        f1i, f3i, g2i, cai = P(f1), P(f3), P(g2), P(c_area)
+        f1i, f3i, g2i, cai = (x.ravel()[node] for x in (f1, f3, g2, c_area))
         A_el = f1i * cai * smu * M[2]
         W_el = 4.0 / 3.0 * Es * g2i * smu**1.5 * M[3]
         k_el = 2.0 * Es * g2i * math.sqrt(smu) * M[1]
@@ -566,10 +566,11 @@ def _elasto_plastic(surface, material, h, n_quad, elliptic, eccentricity, n_t, e
                 epanels[key][idx] = val
         # transition (ZMC) panels: the full formula at their nodes
         idx = np.flatnonzero(tr)
-        node = idx // 4
         if idx.size:
-            At, Wt, Kt = _transition_sums(a.ravel()[idx], b.ravel()[idx], P(d), u, w, smu,
-                                          P(f1), P(f3), P(c_area), P(wc), P(wp), R, chH, slope)
+            node = idx // 4
+            At, Wt, Kt = _transition_sums(a.ravel()[idx], b.ravel()[idx], u, w, smu, R, chH,
+                                          slope, *(x.ravel()[node] for x in (d, f1, f3, c_area,
+                                                                             wc, wp)))
             panels["At"][idx] = At
             panels["Wt"][idx] = Wt
             panels["K"][idx] = Kt

@@ -72,8 +72,8 @@ def _reference(surface, material, h, n_quad, n_t=None):
     def total(val):
         return Ds * np.sum(ex * np.sum(val * wt, axis=-1), axis=(1, 2))
 
-    Ae, At, Ap = total(np.where(el, A_el, 0)), total(np.where(tr, A_tr, 0)), total(np.where(pl, A_pl, 0))
-    We, Wt, Wp = total(np.where(el, W_el, 0)), total(np.where(tr, W_tr, 0)), total(np.where(pl, W_pl, 0))
+    Ae, At, Ap = (total(np.where(m, x, 0)) for m, x in ((el, A_el), (tr, A_tr), (pl, A_pl)))
+    We, Wt, Wp = (total(np.where(m, x, 0)) for m, x in ((el, W_el), (tr, W_tr), (pl, W_pl)))
     K = total(np.where(el, k_el, np.where(pl, k_pl, k_tr))) + Ds * K_jump
     ep = dict(zip(FIELDS, (Ae + At + Ap, We + Wt + Wp, K, Ae, At, Ap, We, Wt, Wp)))
     return ep, (total(A_el), total(W_el), total(k_el))
