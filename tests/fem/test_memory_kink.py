@@ -140,3 +140,27 @@ def test_bolt_normal_cycles_shake_down_with_a_stiffer_unloading_branch():
                                        err_msg=name)
         np.testing.assert_allclose(r.dissipation, r1.dissipation, rtol=1e-10,
                                    atol=1e-10 * dn[0])
+
+
+def test_tangent_on_the_unloading_branch_matches_finite_differences():
+    """The scaled k_T keeps the interface tangent consistent (k_load/k_rev is fixed by the
+    committed h_min): central differences of the traction in the jump, in stick and in slip."""
+    law, _ = flat_punch.make_law(MPI.COMM_SELF, case="b", normal=StiffUnloadingLawWithReversal(),
+                                 seating_pressure=1.0)
+    h_min = 1.6e-3
+    h = h_min + np.array([0.3, 0.3, 0.6, 0.1]) * DELTA_STIFF
+    slip = np.array([[1e-7, 0.0], [2e-4, 1e-4], [-3e-4, 2e-4], [5e-5, -5e-5]])
+    n = h.size
+    state = HistoryInterfaceState.zeros(n)
+    state.h_min[:] = h_min
+    jump = np.column_stack([h - law.h0, slip])
+    res = law.evaluate(jump, state)
+    assert not res.slipping[0] and res.slipping[1:].any()
+    step = 1e-10
+    for j in range(3):
+        dj = np.zeros((n, 3))
+        dj[:, j] = step
+        fd = (law.evaluate(jump + dj, state).traction
+              - law.evaluate(jump - dj, state).traction) / (2 * step)
+        np.testing.assert_allclose(res.tangent[:, :, j], fd, rtol=1e-5,
+                                   atol=1e-5 * np.abs(res.tangent).max(), err_msg=f"column {j}")
