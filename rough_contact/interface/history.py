@@ -672,10 +672,16 @@ class HistoryNormalLaw:
         if self._CF is not None:
             inside = np.flatnonzero(flat < self.h_table_end)
             if inside.size:
-                c, j, tm, _ = self._cell(flat.take(inside), np.zeros(inside.size))
-                cc = self._CF.take(c, axis=1)
-                d = ((cc[13] * tm + cc[9]) * tm + cc[5]) * tm + cc[1]   # d rho/dtx at tx = 0
-                k = -p0.take(inside) * d * self._xinv_h.take(j)
+                # row cell and tm of h_min; x = 0 is the first x cell (tx = 0): only the four
+                # coefficients of tm^p tx^1 (p = 0..3) of rho are gathered
+                tm = _row_v(flat.take(inside), self._hm0, self._span, self._beta)
+                tm *= self._n_m
+                i = np.minimum(tm.astype(np.intp), self._n_m - 1)
+                tm -= i
+                i *= self._xinv.size
+                cc = self._CF[1:16:4].take(i, axis=1)
+                d = ((cc[3] * tm + cc[2]) * tm + cc[1]) * tm + cc[0]   # d rho/dtx at tx = 0
+                k = -p0.take(inside) * d * self._xinv_h[0]
                 kr[inside] = np.maximum(k, kl.take(inside)) if self._capped else k
         return kl.reshape(hm.shape), kr.reshape(hm.shape)
 
