@@ -16,7 +16,8 @@ share the same loading branch:
 Printed per friction case and law: the frictional dissipation D (Table 5's quantity), the normal
 hysteresis D_N (0 for the reversible law), the residual settlement (the mean interface gap and
 the punch top's displacement at the seating load after unloading minus before loading), the
-slipping share of the contact area and the stick ratio at the peak and at the end, the Newton
+slipping share of the contact area at the peak, in the first unloading increment and at the
+end, the stick ratio at the end, the Newton
 iterations and the wall time. Writes ``summary.csv`` and ``increments.csv`` in ``--out`` and the
 figure ``--figure`` (force against the interface closure and against the punch's approach, both
 laws; the slipping area along the program).
@@ -93,6 +94,7 @@ def summarise(rows, seconds):
                 settlement_top_um=last["approach_um"] - first["approach_um"],
                 peak_closure_um=first["mean_gap_um"] - peak["mean_gap_um"],
                 slip_share_peak=peak["slip_share"], stick_ratio_peak=1 - peak["slip_share"],
+                slip_share_first_unload=rows[STEPS]["slip_share"],
                 slip_share_end=last["slip_share"], stick_ratio_end=1 - last["slip_share"],
                 contact_share_end=last["contact_share"],
                 newton=sum(r["newton"] for r in rows), seconds=seconds)
@@ -194,12 +196,14 @@ def main(argv=None):
               "value at 62.5 N after unloading minus before loading")
         print(f"{'case':>4} {'law':>10} {'D [N mm]':>10} {'D_N [N mm]':>10} "
               f"{'gap sett. um':>12} {'top sett. um':>12} {'closure@peak':>12} "
-              f"{'slip% peak':>10} {'slip% end':>9} {'stick end':>9} {'Newton':>6} {'s':>5}")
+              f"{'slip% peak':>10} {'slip% unl.1':>11} {'slip% end':>9} {'stick end':>9} "
+              f"{'Newton':>6} {'s':>5}")
         for s in summary:
             print(f"{s['case']:>4} {s['law']:>10} {s['D_friction_Nmm']:10.4e} "
                   f"{s['D_normal_Nmm']:10.4e} {s['settlement_gap_um']:12.4e} "
                   f"{s['settlement_top_um']:12.4e} {s['peak_closure_um']:12.4f} "
-                  f"{100 * s['slip_share_peak']:10.1f} {100 * s['slip_share_end']:9.1f} "
+                  f"{100 * s['slip_share_peak']:10.1f} {100 * s['slip_share_first_unload']:11.1f} "
+                  f"{100 * s['slip_share_end']:9.1f} "
                   f"{s['stick_ratio_end']:9.3f} {s['newton']:6d} {s['seconds']:5.0f}")
         for case in args.cases:
             r, mm = (next(s for s in summary if s["case"] == case and s["law"] == n)

@@ -62,7 +62,8 @@ import numpy as np
 from ..validation import check_scalar
 from .normal import NormalLaw
 
-__all__ = ["HistoryNormalLawProtocol", "HistoryNormalLaw", "UnloadingAboveLoadingWarning"]
+__all__ = ["HistoryNormalLawProtocol", "ReversalStiffnessProtocol", "HistoryNormalLaw",
+           "UnloadingAboveLoadingWarning"]
 
 
 @runtime_checkable
@@ -84,6 +85,26 @@ class HistoryNormalLawProtocol(Protocol):
     def normal_dissipation(self, h_min: np.ndarray) -> np.ndarray:
         """D(h_min) (n,) [N/mm]: energy per nominal area dissipated by loading to h_min, so
         that the work of any path is psi(h, h_min) + D(h_min); 0 where nothing yielded."""
+        ...
+
+
+@runtime_checkable
+class ReversalStiffnessProtocol(Protocol):
+    """A normal law with memory that states the stiffness at the reversal h = h_min.
+
+    At h = h_min the normal tangent jumps from the loading tangent k_load(h_min) (h <= h_min)
+    to the first unloading stiffness k_rev(h_min) = -dp/dh at h -> h_min+ (usually stiffer).
+    p is continuous there, the normal tangent need not be: Newton copes with that kink. But a
+    tangential stiffness k_T = c k_N would jump with it and make the interface traction itself
+    discontinuous at h = h_min, exactly where every loaded point sits at the peak of a repeated
+    load cycle. ``rough_contact.interface.law.InterfaceLaw`` therefore scales k_N by
+    k_load(h_min)/k_rev(h_min) in the tangential stiffness on the unloading branch when the
+    normal law implements this protocol (k_T continuous at the reversal; docs/unloading.md).
+    """
+
+    def reversal_stiffness(self, h_min: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
+        """(k_load(h_min), k_rev(h_min)) (n,) [MPa/mm]: the loading tangent at h_min and the
+        unloading branch's stiffness at h -> h_min+ (k_rev = k_load for a reversible law)."""
         ...
 
 
@@ -637,6 +658,32 @@ class HistoryNormalLaw:
         out[0][idx], out[1][idx], out[2][idx] = p, k, a
         if curvature:
             out[3][idx] = dk
+
+    def reversal_stiffness(self, h_min) -> Tuple[np.ndarray, np.ndarray]:
+        """(k_load(h_min), k_rev(h_min)) [MPa/mm] (``ReversalStiffnessProtocol``): the loading
+        tangent and the stiffness of the unloading branch of h_min at its start, the limit of
+        ``evaluate_history(h, h_min)[1]`` as h -> h_min+ (the table's d rho/dx at x = 0; with
+        a capped table the larger of the two, as the cap then takes the loading branch). Equal
+        for the reversible law and where h_min >= h_table_end."""
+        hm = np.asarray(h_min, dtype=float)
+        flat = hm.ravel()
+        p0, kl, _ = self.loading.evaluate(flat)
+        kr = np.array(kl, dtype=float, copy=True)
+        if self._CF is not None:
+            inside = np.flatnonzero(flat < self.h_table_end)
+            if inside.size:
+                # row cell and tm of h_min; x = 0 is the first x cell (tx = 0): only the four
+                # coefficients of tm^p tx^1 (p = 0..3) of rho are gathered
+                tm = _row_v(flat.take(inside), self._hm0, self._span, self._beta)
+                tm *= self._n_m
+                i = np.minimum(tm.astype(np.intp), self._n_m - 1)
+                tm -= i
+                i *= self._xinv.size
+                cc = self._CF[1:16:4].take(i, axis=1)
+                d = ((cc[3] * tm + cc[2]) * tm + cc[1]) * tm + cc[0]   # d rho/dtx at tx = 0
+                k = -p0.take(inside) * d * self._xinv_h[0]
+                kr[inside] = np.maximum(k, kl.take(inside)) if self._capped else k
+        return kl.reshape(hm.shape), kr.reshape(hm.shape)
 
     def normal_dissipation(self, h_min) -> np.ndarray:
         """D(h_min) [N/mm] (module doc): cubic Hermite with monotone slopes through the rows'

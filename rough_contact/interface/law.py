@@ -26,7 +26,7 @@ import numpy as np
 from ..validation import check_scalar
 from .contract import LawResult, check_jump
 from .friction import FrictionInput, IsotropicSlipHardening, OrthotropicSlipHardening
-from .history import HistoryNormalLawProtocol
+from .history import HistoryNormalLawProtocol, ReversalStiffnessProtocol
 from .state import HistoryInterfaceState, InterfaceState
 from .tangential import TangentialStiffness
 
@@ -99,6 +99,14 @@ class InterfaceLaw:
     where h <= h_min and the elastic unloading/reloading branch of h_min elsewhere, and
     ``LawResult.normal_dissipation`` is the normal hysteresis energy of the step. A plain
     ``NormalLaw`` (e.g. the elasto-plastic one, the default) stays reversible.
+
+    Tangential stiffness with memory: k_T = c k_N on the loading branch (the paper's rule);
+    on the unloading branch of h_min, if the normal law implements
+    ``ReversalStiffnessProtocol``, k_T = c k_N k_load(h_min)/k_rev(h_min): the unloading
+    stiffness scaled so that k_T is continuous at h = h_min (where k_N jumps from the loading
+    tangent to the stiffer first unloading stiffness). Without the scale the tangential
+    traction c k_N (s - s_p) jumps at h = h_min, and the residual is discontinuous at the
+    peak of every repeated load cycle (Newton stalls; docs/unloading_scenes.md).
     """
 
     normal: NormalLawProtocol
@@ -227,18 +235,28 @@ class InterfaceLaw:
         cx, cy = self.tangential.kt_over_kn
         sp = committed.plastic_slip
         kap = committed.accumulated_slip
+        kt, dkt = k, dk         # k_T / c and its h-derivative
+        if normal_dissipation is not None and isinstance(self.normal, ReversalStiffnessProtocol):
+            un = np.flatnonzero(h > committed.h_min)      # on the unloading branch of h_min
+            if un.size:
+                kl, kr = self.normal.reversal_stiffness(committed.h_min.take(un))
+                ok = kr > 0.0
+                scale = np.where(ok, kl / np.where(ok, kr, 1.0), 1.0)
+                kt, dkt = k.copy(), dk.copy()
+                kt[un] *= scale
+                dkt[un] *= scale
         if contact.all():  # work on views: no gather/scatter
-            pts_in = FrictionInput(jump[:, 1] - sp[:, 0], jump[:, 2] - sp[:, 1], cx * k, cy * k,
-                                   cx * dk, cy * dk, p, k, kap[:, 0], kap[:, 1],
+            pts_in = FrictionInput(jump[:, 1] - sp[:, 0], jump[:, 2] - sp[:, 1], cx * kt,
+                                   cy * kt, cx * dkt, cy * dkt, p, k, kap[:, 0], kap[:, 1],
                                    committed.slip_path)
             slip = self.friction.evaluate(pts_in, traction[:, 1:], tangent[:, 1:, :])
             pts = slip.slip_index
         else:
             ic = np.flatnonzero(contact)
-            kc, dkc = k.take(ic), dk.take(ic)
+            kc, dkc = kt.take(ic), dkt.take(ic)
             pts_in = FrictionInput(jump[ic, 1] - sp[ic, 0], jump[ic, 2] - sp[ic, 1], cx * kc,
-                                   cy * kc, cx * dkc, cy * dkc, p.take(ic), kc, kap[ic, 0],
-                                   kap[ic, 1], committed.slip_path.take(ic))
+                                   cy * kc, cx * dkc, cy * dkc, p.take(ic), k.take(ic),
+                                   kap[ic, 0], kap[ic, 1], committed.slip_path.take(ic))
             slip = self.friction.evaluate(pts_in)
             traction[ic, 1:] = slip.traction
             tangent[ic, 1:, :] = slip.tangent
