@@ -107,8 +107,9 @@ class FrictionInput:
 
     Attributes:
         elastic_slip_x, elastic_slip_y: trial elastic slip e = s - s_p(committed) [mm].
-        kt_x, kt_y: tangential stiffnesses kT_i = c_i kN(h) > 0 [MPa/mm].
-        dkt_x, dkt_y: their derivatives d kT_i / d g = c_i dkN/dh [MPa/mm^2].
+        kt_x, kt_y: tangential stiffnesses kT_i = c_i kN(h) > 0 [MPa/mm] (with a memory law,
+            on the unloading branch c_i kN(h) kN_load(h_min)/kN_rev(h_min): InterfaceLaw).
+        dkt_x, dkt_y: their derivatives d kT_i / d g [MPa/mm^2].
         pressure: contact pressure p >= 0 [MPa].
         kn: normal stiffness kN = -dp/dg >= 0 [MPa/mm].
         kappa_x, kappa_y: committed accumulated slip magnitudes, hardening variables of the
