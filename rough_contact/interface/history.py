@@ -51,6 +51,7 @@ and ln(a/a0) likewise, over [h_lo, h_table_end] x [0, X]:
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 import warnings
@@ -170,8 +171,9 @@ def _cells(v, d, xk):
 
 def _poly(cc, tm, tx, second=False):
     """rho, d rho/dtx (and d2 rho/dtx2) and ln(a/a0) of the gathered cell coefficients cc
-    (32, n) at (tm, tx) (Horner in tm for both tables at once, then in tx)."""
-    c4 = cc.reshape(2, 4, 4, -1)                          # [k, p, q, point]
+    (32, n) at (tm, tx) (Horner in tm for both tables at once, then in tx); ln(a/a0) is None
+    if cc holds rho's 16 coefficients only."""
+    c4 = cc.reshape(-1, 4, 4, tm.size)                    # [k, p, q, point]
     g = c4[:, 3] * tm
     g += c4[:, 2]
     g *= tm
@@ -188,11 +190,12 @@ def _poly(cc, tm, tx, second=False):
     dv += 2.0 * g[0, 2]
     dv *= tx
     dv += g[0, 1]
+    la = v[1] if v.shape[0] == 2 else None
     if second:
         d2 = g[0, 3] * (6.0 * tx)
         d2 += 2.0 * g[0, 2]
-        return v[0], dv, v[1], d2
-    return v[0], dv, v[1]
+        return v[0], dv, la, d2
+    return v[0], dv, la
 
 
 def _hermite_mid(v, d, xk):
@@ -249,6 +252,13 @@ class HistoryNormalLaw:
     _IL: float = 0.0                    # int exp(rho(row 0, x)) dx incl. taper [-]
     _capped: bool = False               # the sums went above the loading branch: cap by it
     info: dict = field(default_factory=dict, compare=False)   # build statistics, not identity
+    _memo: dict = field(default_factory=dict, compare=False, repr=False)  # h_min data, not identity
+
+    def __getstate__(self):
+        """Pickle without the remembered h_min data."""
+        state = dict(self.__dict__)
+        state.pop("_memo", None)
+        return state
 
     def __setstate__(self, state):
         """Unpickle; a table pickled by the session-3 code (uniform bicubic grid, keys _C, _dm)
@@ -259,6 +269,7 @@ class HistoryNormalLaw:
                              "cannot be read; delete the cached file and rebuild the law")
         for key, value in state.items():
             object.__setattr__(self, key, value)
+        object.__setattr__(self, "_memo", {})
 
     # ------------------------------------------------------------ NormalLaw interface
     @property
@@ -563,9 +574,16 @@ class HistoryNormalLaw:
         return bool(np.all(k >= 0.0))
 
     # ------------------------------------------------------------ evaluation
-    def evaluate_history(self, h, h_min, curvature: bool = False):
+    def evaluate_history(self, h, h_min, curvature: bool = False, area: bool = True):
         """(p [MPa], k = -dp/dh|_{h_min} [MPa/mm], A/A0 [-][, dk/dh [MPa/mm^2]]) at
-        separations h after the smallest separation h_min (broadcast; h <= h_min: loading)."""
+        separations h after the smallest separation h_min (broadcast; h <= h_min: loading;
+        h_min >= h_table_end: the loading law at h). ``area=False`` skips A/A0 (returned as
+        None; p, k, dk/dh unchanged): a Newton iteration needs p and k only.
+
+        What an unloading point needs of its h_min alone (p_load(h_min), A0, the row cell and
+        its local coordinate) is remembered for the last h_min array seen (a Newton loop calls
+        with the same committed h_min every iteration): the values are those of a first call,
+        bit for bit, only not recomputed."""
         h = np.asarray(h, dtype=float)
         hmn = np.asarray(h_min, dtype=float)
         if np.isnan(h).any() or np.isnan(hmn).any():
@@ -574,42 +592,118 @@ class HistoryNormalLaw:
         shape = h.shape
         h, hmn = h.ravel(), hmn.ravel()
         if self._CF is None:                      # reversible: h_min has no effect
-            return tuple(v.reshape(shape) for v in self.loading.evaluate(h, curvature))
-        # one loading evaluation per point, at min(h, h_min): the loading branch where h <=
-        # h_min, else the branch's start p0 = p_load(h_min), a0; in blocks that stay in cache
+            res = [v.reshape(shape) for v in self.loading.evaluate(h, curvature)]
+            if not area:
+                res[2] = None
+            return tuple(res)
         n = h.size
         out = [np.empty(n) for _ in range(4 if curvature else 3)]
-        load_block, h_end = self.loading._eval_block, self.h_table_end
-        for s in range(0, n, _BLOCK):
+        memo = self._memo_of(hmn)
+        h_end = self.h_table_end
+        load_block = (self.loading if area else self._loading_without_area())._eval_block
+
+        def ob4(o):                               # p, k, a, dk (None without curvature)
+            return (o[0], o[1], o[2], o[3] if curvature else None)
+
+        for s in range(0, n, _BLOCK):             # blocks that stay in cache
             e = min(s + _BLOCK, n)
             hb, mb = h[s:e], hmn[s:e]
             ob = [o[s:e] for o in out]
-            load_block(np.minimum(hb, mb), ob[0], ob[1], ob[2], ob[3] if curvature else None)
-            un = np.flatnonzero((hb > mb) & (mb < h_end))
-            if un.size:
-                self._unload(hb.take(un), mb.take(un), ob, un, curvature)
-        return tuple(v.reshape(shape) for v in out)
+            unm = hb > mb
+            unm &= mb < h_end
+            un = np.flatnonzero(unm)
+            if not un.size:
+                load_block(hb, *ob4(ob))
+                continue
+            if memo.p0 is not None:
+                # h_min data remembered: the loading law only at the loading points
+                ld = np.flatnonzero(~unm)
+                if ld.size:
+                    tmp = [np.empty(ld.size) for _ in ob]
+                    load_block(hb.take(ld), *ob4(tmp))
+                    for o, t in zip(ob, tmp):
+                        o[ld] = t
+                ug = un + s
+                p0, a0 = memo.p0.take(ug), memo.a0.take(ug)
+                base, tm = memo.base.take(ug), memo.tm.take(ug)
+            else:
+                # one loading evaluation per point: at h, or at h_min where unloading (p0, a0)
+                load_block(np.where(unm, mb, hb), *ob4(ob))
+                p0, a0 = ob[0].take(un), ob[2].take(un)
+                base, tm = self._row_cell(mb.take(un))
+            self._unload(hb.take(un), mb.take(un), p0, a0, base, tm, ob, un, curvature, area)
+        res = [v.reshape(shape) for v in out]
+        if not area:
+            res[2] = None
+        return tuple(res)
 
-    def _unload(self, h, hm, out, idx, curvature):
-        """The unloading branch at the points idx (h > h_min, h_min < h_table_end) of out,
-        whose loading values there are those at h_min (p0, a0)."""
+    def _loading_without_area(self) -> NormalLaw:
+        """The loading law that skips A/A0 (a = 0): the same p, k, dk/dh."""
+        law = self._memo.get("loading_without_area")
+        if law is None:
+            law = dataclasses.replace(self.loading, has_area=False)
+            self._memo["loading_without_area"] = law
+        return law
+
+    def _memo_of(self, hmn) -> "_HminMemo":
+        """The remembered h_min data of this h_min array: a new record (h_min only) if it is
+        not the array of the last call; at the second call with it, its data at every point
+        (from then on an unloading point skips the loading law at h_min and the row look-up)."""
+        memo = self._memo.get("h_min")
+        if memo is None or memo.h_min.shape != hmn.shape or not np.array_equal(memo.h_min, hmn):
+            memo = _HminMemo(hmn)
+            self._memo["h_min"] = memo
+        elif memo.p0 is None:
+            hm = np.minimum(memo.h_min, self.h_table_end)       # only h_min < h_end is used
+            p0, a0 = np.empty(hm.size), np.empty(hm.size)
+            for s in range(0, hm.size, _BLOCK):
+                e = min(s + _BLOCK, hm.size)
+                self.loading._eval_block(hm[s:e], p0[s:e], np.empty(e - s), a0[s:e], None)
+            memo.base, memo.tm = self._row_cell(hm)
+            memo.p0, memo.a0 = p0, a0
+        return memo
+
+    def _row_cell(self, hm):
+        """First cell index (row cell i times the x cells) and local row coordinate tm of h_min."""
+        um = _row_v(hm, self._hm0, self._span, self._beta)
+        um *= self._n_m
+        i = np.minimum(um.astype(np.intp), self._n_m - 1)
+        um -= i
+        i *= self._xinv.size
+        return i, um
+
+    def _unload(self, h, hm, p0, a0, base, tm, out, idx, curvature, area=True):
+        """The unloading branch at the points idx (h > h_min, h_min < h_table_end) of out;
+        p0, a0: the loading law at h_min; base, tm: ``_row_cell(h_min)``; ``area=False``:
+        out[2] is left as it is (rho's cells only)."""
         sig = self.sigma
         x = h - hm
         x *= 1.0 / sig
         xc = np.minimum(x, self._X)
-        c, j, tm, tx = self._cell(hm, xc)
-        r = _poly(self._CF.take(c, axis=1), tm, tx, second=curvature)
+        j = self._lut.take((xc * self._lut_inv).astype(np.intp))
+        j += xc >= self._xnext.take(j)
+        tx = xc - self._xk.take(j)
+        tx *= self._xinv.take(j)
+        CF = self._CF if area else self._CF[:16]
+        r = _poly(CF.take(base + j, axis=1), tm, tx, second=curvature)
         p = np.exp(r[0])
-        p *= out[0].take(idx)
+        p *= p0
+        s = self._xinv_h.take(j)
         d1 = r[1]
-        d1 *= self._xinv_h.take(j)                # d rho/dh = d rho/dtx dtx/dh
+        d1 *= s                                   # d rho/dh = d rho/dtx dtx/dh
         k = p * d1
         np.negative(k, out=k)
-        a = np.exp(r[2])
-        a *= out[2].take(idx)
+        if area:
+            a = np.exp(r[2])
+            a *= a0
+        else:
+            a = np.zeros(h.size)
         if curvature:
-            s = self._xinv_h.take(j)
-            dk = -p * (r[3] * s * s + d1 * d1)
+            dk = r[3] * s
+            dk *= s
+            dk += d1 * d1
+            dk *= p
+            np.negative(dk, out=dk)
         if x.max() > self._X:
             tp = np.flatnonzero(x > self._X)
             pe, ke, ae = p[tp], k[tp], a[tp]
@@ -634,7 +728,9 @@ class HistoryNormalLaw:
                 p[up], k[up], a[up] = lp[up], lk[up], la[up]
                 if curvature:
                     dk[up] = ld[up]
-        out[0][idx], out[1][idx], out[2][idx] = p, k, a
+        out[0][idx], out[1][idx] = p, k
+        if area:
+            out[2][idx] = a
         if curvature:
             out[3][idx] = dk
 
@@ -664,6 +760,17 @@ class HistoryNormalLaw:
             p0 = self.loading.evaluate(hb)[0]
             out[below] = np.maximum(W - self.sigma * p0 * self._IL, 0.0)
         return out.reshape(hm.shape)
+
+
+class _HminMemo:
+    """What the unloading points of one h_min array need of h_min alone: p_load(h_min), A0,
+    first cell index and row coordinate (``HistoryNormalLaw._row_cell``); None until filled."""
+
+    __slots__ = ("h_min", "p0", "a0", "base", "tm")
+
+    def __init__(self, h_min):
+        self.h_min = h_min.copy()
+        self.p0 = self.a0 = self.base = self.tm = None
 
 
 class UnloadingAboveLoadingWarning(UserWarning):

@@ -264,3 +264,71 @@ def test_unloading_above_loading_is_capped_by_the_loading_branch():
     u = np.array([0.25, 0.5, 1.0]) * SIG
     r_load = -u / LAM
     assert H._count_above_loading(r_load + [0.3, -0.2, 0.5e-4], law.loading, 1e-3, u, 1e-4) == 1
+
+
+def test_h_min_beyond_the_table_end_gives_the_loading_law_at_h():
+    """h_min >= h_table_end: nothing has yielded, the loading law at h (reversible). The law
+    returned the loading law at h_min there (p frozen at p_load(h_min) while k = k_load(h_min)
+    > 0: a tangent that is not the derivative of p)."""
+    law = _synthetic(_rho, _drho, _la, _dla)
+    L = law.loading
+    hm = np.linspace(L.h_table_end, L.h_max, 41)[:-1]
+    h = hm + 0.3 * (L.h_max - hm)
+    for got, want in zip(law.evaluate_history(h, hm, curvature=True), L.evaluate(h, True)):
+        np.testing.assert_array_equal(got, want)
+    d = 1e-4 * (L.h_max - L.h_table_end)
+    k_fd = (law.evaluate_history(h - d, hm)[0] - law.evaluate_history(h + d, hm)[0]) / (2 * d)
+    np.testing.assert_allclose(law.evaluate_history(h, hm)[1], k_fd, rtol=1e-4)
+
+
+def _mixed_points(law, n, seed):
+    """Loading, unloading, taper, below-table, beyond-the-table-end and virgin points."""
+    rng = np.random.default_rng(seed)
+    lo, hi = law.h_min - 0.2 * law._span, law.h_max
+    hm = rng.uniform(lo, hi, n)
+    hm[::9] = np.inf
+    h = hm + rng.uniform(-0.5, 1.5, n) * XK[-1] * SIG
+    h[::9] = rng.uniform(lo, hi, h[::9].size)
+    return h, hm
+
+
+@pytest.mark.parametrize("curvature", [False, True])
+def test_repeated_h_min_is_remembered_bit_for_bit(curvature):
+    """A Newton loop calls with the same committed h_min every iteration: from the second
+    call on, what unloading points need of h_min alone is remembered. Every call must give
+    exactly what a law that never saw this h_min gives (a fresh copy), for changing h, with
+    and without A/A0, over several evaluation blocks; and an h_min array changed in place
+    must not be mistaken for the remembered one."""
+    import pickle
+    law = _synthetic(_rho, _drho, _la, _dla)
+    n = 2 * H._BLOCK + 777
+    h, hm = _mixed_points(law, n, 7)
+    rng = np.random.default_rng(8)
+    for it, area in enumerate([False, False, True, True, False, True]):
+        hh = h + rng.normal(0.0, 0.05, n) * SIG * (it > 0)
+        got = law.evaluate_history(hh, hm, curvature, area=area)
+        fresh = pickle.loads(pickle.dumps(law)).evaluate_history(hh, hm, curvature, area=area)
+        assert (got[2] is None) == (not area) and (fresh[2] is None) == (not area)
+        for x, y in zip(got, fresh):
+            if y is not None:
+                np.testing.assert_array_equal(x, y)
+    assert law._memo["h_min"].p0 is not None           # the hot path was taken
+    hm[::3] -= 0.3 * SIG                               # changed in place: not the same h_min
+    got = law.evaluate_history(h, hm, curvature)
+    fresh = pickle.loads(pickle.dumps(law)).evaluate_history(h, hm, curvature)
+    for x, y in zip(got, fresh):
+        np.testing.assert_array_equal(x, y)
+
+
+def test_without_area_same_p_k_dk():
+    law = _synthetic(_rho, _drho, _la, _dla)
+    h, hm = _mixed_points(law, 5000, 9)
+    full = law.evaluate_history(h, hm, curvature=True)
+    part = law.evaluate_history(h, hm, curvature=True, area=False)
+    assert part[2] is None
+    for i in (0, 1, 3):
+        np.testing.assert_array_equal(part[i], full[i])
+    rev = HistoryNormalLaw(loading=law.loading, rtol=1e-3)      # reversible: h_min ignored
+    p, k, a = rev.evaluate_history(h, hm, area=False)
+    assert a is None
+    np.testing.assert_array_equal(p, law.loading.evaluate(h)[0])
