@@ -93,7 +93,7 @@ class HistoryNormalLawProtocol(Protocol):
 _B = np.array([[1.0, -3.0, 3.0, -1.0], [4.0, 0.0, -6.0, 3.0], [1.0, 3.0, 3.0, -3.0],
                [0.0, 0.0, 0.0, 1.0]]) / 6.0
 _GRADING = 1.0       # row grading beta: row spacing grows 1 + 2 beta = 3x from h_lo to h_end
-_BLOCK = 8192        # points per evaluation block (about half of them on the unloading branch)
+_BLOCK = 32768       # points per evaluation block: fewer numpy calls per point (8192: 10-15 % slower)
 
 
 def _row_h(v, h0, span, beta):
