@@ -225,3 +225,18 @@ def test_direct_sums_high_above_the_mean_plane_need_24_zeta_nodes(psi):
     assert abs(a[0, 0] / load.pressure[0] - 1) < 1e-5
     old = np.array(U._row_sums(S1, mat, hm, u, 16, 16)[:3])      # n_zeta = n_quad = 16
     assert np.max(np.abs(old / ref - 1)) > 1e-4
+
+
+@pytest.mark.parametrize("e1", [1.0, 0.3, 0.05])
+def test_delta_e_inversion_recovers_omega_max(e1):
+    """The panel start t2 of the unloading sums: the largest interference whose recovered
+    interference delta_e equals u, found by ``_invert_delta_e`` (safeguarded Newton) to round-off; checked
+    against ``recovered_interference`` (the summit's own loading law and delta_e) at omega_max
+    across the elasto-plastic range and beyond it (plastic, closed form)."""
+    kappa, f1, f2, f3, wc, wp = U._resolve(KAPPA, e1, MAT, "exact")
+    W = np.concatenate([np.geomspace(1.0 + 1e-6, float(wp / wc) * (1 - 1e-9), 300),
+                        np.geomspace(float(wp / wc) * 1.001, 1e3, 30)]) * wc
+    _, de = U.recovered_interference(W, KAPPA, e1, MAT)
+    smu = 1e-3                                      # any length scale: t = omega/smu
+    t2 = U._invert_delta_e(de / smu, wc / smu, wp / smu, kappa, f1, f2, f3, wc, wp, MAT, smu)
+    np.testing.assert_allclose(t2 * smu, W, rtol=1e-12)      # (bisection + secant: 5.5e-11)
