@@ -213,22 +213,24 @@ def _invert_delta_e(tau, tc, tp, kappa, f1, f2, f3, wc, wp, mat, smu, n_iter=40)
         flo, fhi = Z(dec) - target, Z(dep) - target          # < 0 and > 0
         cS = 2.0 * Es * (g2 / np.sqrt(g1)) / math.sqrt(math.pi)        # S(A) = cS sqrt(A)
         t = lo_ - flo * (hi_ - lo_) / (fhi - flo)
-        for _ in range(n_iter):
-            A, dA = zmc_area(smu * t, ka, g1, g3, c, p_)        # ZMC branch only
-            pa, dpa = zmc_mean_pressure(smu * t, c, mat)
+        act = np.arange(t.size)          # not converged yet (each point on its own: the
+        for _ in range(n_iter):          # result does not depend on the other points)
+            ti, lo_i, hi_i = t[act], lo_[act], hi_[act]
+            A, dA = zmc_area(smu * ti, ka[act], g1[act], g3[act], c[act], p_[act])
+            pa, dpa = zmc_mean_pressure(smu * ti, c[act], mat)      # ZMC branch only
             sA = np.sqrt(A)
-            f = 1.5 * pa * sA / cS - target
-            df = 1.5 * smu / cS * (dpa * sA + 0.5 * pa * dA / sA)   # d delta_e/dt
+            f = 1.5 * pa * sA / cS[act] - target[act]
+            df = 1.5 * smu / cS[act] * (dpa * sA + 0.5 * pa * dA / sA)   # d delta_e/dt
             up = f < 0
-            lo_ = np.where(up, t, lo_)
-            hi_ = np.where(up, hi_, t)
+            lo_i = np.where(up, ti, lo_i)
+            hi_i = np.where(up, hi_i, ti)
             with np.errstate(divide="ignore", invalid="ignore"):
-                tn = t - f / df
-            out = ~((tn >= lo_) & (tn <= hi_))                 # also NaN
-            tn[out] = 0.5 * (lo_[out] + hi_[out])
-            done = np.abs(tn - t) <= 1e-10 * t
-            t = tn
-            if done.all():
+                tn = ti - f / df
+            out = ~((tn >= lo_i) & (tn <= hi_i))               # also NaN
+            tn[out] = 0.5 * (lo_i[out] + hi_i[out])
+            t[act], lo_[act], hi_[act] = tn, lo_i, hi_i
+            act = act[np.abs(tn - ti) > 1e-10 * ti]
+            if not act.size:
                 break
         hi[zmc] = t
     return np.where(smu * tau <= dec, tc, np.where(smu * tau >= dep, np.maximum(tpl, tp), hi))

@@ -240,3 +240,16 @@ def test_delta_e_inversion_recovers_omega_max(e1):
     smu = 1e-3                                      # any length scale: t = omega/smu
     t2 = U._invert_delta_e(de / smu, wc / smu, wp / smu, kappa, f1, f2, f3, wc, wp, MAT, smu)
     np.testing.assert_allclose(t2 * smu, W, rtol=1e-12)      # (bisection + secant: 5.5e-11)
+
+
+def test_direct_sums_of_a_point_do_not_depend_on_the_other_points():
+    """The history table computes a row's points in several calls (and its u = 0 point once):
+    the sums at one point must be bit for bit the same whatever else is in the call (the
+    Newton inversion of delta_e stops per point, not when the whole batch has converged)."""
+    mat = AsperityMaterial(E_star=E_STAR, psi=1.0).resolve(S1)
+    sig = S1.rq
+    u = np.array([0.0, 0.05, 0.4, 1.0, 2.5, 5.0]) * sig
+    together = np.array(U._row_sums(S1, mat, 0.3 * sig, u, 16, 16, 24))
+    alone = np.array([np.array(U._row_sums(S1, mat, 0.3 * sig, u[i:i + 1], 16, 16, 24))[:, 0]
+                      for i in range(u.size)]).T
+    np.testing.assert_array_equal(together, alone)
