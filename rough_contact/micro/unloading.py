@@ -312,41 +312,67 @@ def _node_integrals(C, l, tau, K, zeta, n_t):
         vpk = np.clip(np.sqrt(np.maximum(-dl - T0, 0.0)), 0.0, vb)
         acc = [np.zeros(live.size) for _ in range(4)]
         cA = np.pi / ka
+        # per-node constants of the regime's (A, P, delta_e) (asperity.zmc_area,
+        # zmc_mean_pressure and the plastic law, written out: the height loop is the hot path)
         if regime == 0:
             cP = 4.0 / 3.0 * Es * g2 / np.sqrt(ka)
-        else:   # S(A) = cS sqrt(A)
-            cS = 2.0 * Es * (g2 / np.sqrt(g1)) / math.sqrt(math.pi)
+            cAe = g1 * cA
+        else:   # delta_e = 1.5 P/S(A), S(A) = cS sqrt(A)
+            rcS = 1.5 / (2.0 * Es * (g2 / np.sqrt(g1)) / math.sqrt(math.pi))
+        if regime == 1:
+            # A = cA W (f1 + (2 f3 - f1) S(y)), S = 3 y^2 - 2 y^3, y = (W - wc)/(wp - wc)
+            # in [0, 1]; pa = ch H - slope ln(R wc/W), W clipped to [wc, wp]
+            idw = 1.0 / (q - c)
+            d31 = 2.0 * g3 - g1
+            R = mat.omega_p_ratio
+            slope = mat.H * (mat.ch - 2.0 * mat.K_nu / 3.0) / math.log(R)
+            lRc = np.log(R * c)
+        elif regime == 2:
+            cAp = 2.0 * g3 * cA
+            chH = mat.ch * mat.H
         uta = smu * ta
         for lo, hi in ((0.0, vpk), (vpk, vb)):
+            span2 = 2.0 * (hi - lo)
             for j in range(n_t):
                 v = lo + (hi - lo) * x[j]
                 t = T0 + v * v
-                jac = 2.0 * v * (hi - lo) * w[j]
+                jac = v * span2 * w[j]
                 W = smu * t
                 if regime == 0:
-                    A, P = g1 * cA * W, cP * W * np.sqrt(W)
+                    A = cAe * W
+                    P = cP * W * np.sqrt(W)
                     de = np.maximum(W, 1e-300)        # W = 0 only at a node of weight 0
-                elif regime == 1:
-                    A, _ = zmc_area(W, ka, g1, g3, c, q)
-                    P = A * zmc_mean_pressure(np.clip(W, c, q), c, mat)[0]
-                    de = np.minimum(1.5 * P / (cS * np.sqrt(A)), W)
                 else:
-                    A = 2.0 * g3 * cA * W
-                    P = mat.ch * mat.H * A
-                    de = np.minimum(1.5 * P / (cS * np.sqrt(A)), W)
+                    if regime == 1:
+                        y = (W - c) * idw
+                        np.clip(y, 0.0, 1.0, out=y)
+                        A = cA * W * (g1 + d31 * (y * y * (3.0 - 2.0 * y)))
+                        P = A * (slope * (np.log(np.clip(W, c, q)) - lRc) + mat.ch * mat.H)
+                    else:
+                        A = cAp * W
+                        P = chH * A
+                    de = rcS * P / np.sqrt(A)
+                    np.minimum(de, W, out=de)
                 ide = 1.0 / de
-                xi = 1.0 - uta * ide                  # in (0, 1] inside the panel
+                xi = uta * ide                        # 1 - xi in (0, 1] inside the panel
+                np.subtract(1.0, xi, out=xi)
                 np.maximum(xi, 0.0, out=xi)
-                ide = np.where(xi > 0, ide, 0.0)
+                ide[xi <= 0] = 0.0
                 sx = np.sqrt(xi)
                 tt = t + dl
-                g = jac * np.exp(pr - 0.5 * tt * tt)
-                gP = g * P
+                tt *= tt
+                tt *= -0.5
+                tt += pr
+                g = np.exp(tt, out=tt)
+                g *= jac
                 gA = g * A
-                acc[0] += gP * xi * sx
-                acc[1] += 1.5 * gP * sx * ide
+                g *= P                                # g P
+                sx *= g                               # g P sqrt(xi)
+                acc[0] += sx * xi
+                acc[1] += sx * ide
                 acc[2] += gA * xi
                 acc[3] += gA * ide
+        acc[1] *= 1.5
         for o, a in zip(out, acc):
             o[live] += a
     return [o.reshape(shape) for o in out]
