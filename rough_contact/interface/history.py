@@ -454,35 +454,62 @@ class HistoryNormalLaw:
             xs = xk[np.unique(np.r_[np.arange(0, xk.size, 4), xk.size - 1])]    # sparse
             checks: list = []               # full checks (nm, error)
             while True:
-                # rows uniform in v, with one ghost row beyond each end (interior spline
-                # conditions at the table's ends)
-                hm = _row_h(np.arange(-1, nm + 2) / nm, hL, span, beta)
-                m = model(hm, xk)
-                table = (hm, m)
+                # rows uniform in v; the coarse levels without ghost rows (not-a-knot at the
+                # table's ends) and checked at the interior row midpoints; a candidate for
+                # the table gets one ghost row beyond each end (interior spline conditions at
+                # the ends: the end intervals' error was 3x the interior's without them) and
+                # is checked at every row midpoint
+                v = np.arange(nm + 1) / nm
+                rows = _row_h(v, hL, span, beta)
                 hmid = _row_h((np.arange(nm) + 0.5) / nm, hL, span, beta)
-                law = cls._assemble(loading, rtol, sig, hm, xk, m, beta, energy=False)
 
-                def check(xq):
-                    r, dr, la = law._rho(np.repeat(hmid, xq.size), np.tile(xq, hmid.size))
-                    ref = model(hmid, xq)
+                def check(law, xq, mids):
+                    hq = hmid[mids]
+                    r, dr, la = law._rho(np.repeat(hq, xq.size), np.tile(xq, hq.size))
+                    ref = model(hq, xq)
                     return _rel_errors(r, dr, la, [q.ravel() for q in ref[:3]], tail)
 
+                def ghosted():
+                    hm = _row_h(np.arange(-1, nm + 2) / nm, hL, span, beta)
+                    m = model(hm, xk)
+                    return (hm, m, True), cls._assemble(loading, rtol, sig, hm, xk, m, beta,
+                                                  energy=False)
+
+                every = np.arange(nm)
                 # embedded estimate: the error of the last level / 16 (rows doubled, cubic),
                 # taken as / 8, once the last two checks have shown that rate (>= 8); if it
-                # passes, the check at every fourth x knot only confirms it
+                # passes, the table's check at every fourth x knot only confirms it
+                est = None
                 if len(checks) >= 2 and checks[-2][1] >= _HALF_ROWS_RATE * checks[-1][1]:
                     est = checks[-1][1] * _HALF_ROWS
-                    if est <= 0.5 * rtol:
-                        worst_m = check(xs)
-                        levels.append((nm, worst_m, n_pts[0], "sparse", est))
-                        if worst_m <= 0.5 * rtol:
-                            worst_m = max(worst_m, est)
-                            break
-                worst_m = check(xc)
+                if est is not None and est <= 0.5 * rtol:
+                    table, law = ghosted()
+                    worst_m = check(law, xs, every)
+                    levels.append((nm, worst_m, n_pts[0], "sparse", est))
+                    if worst_m <= 0.5 * rtol:
+                        worst_m = max(worst_m, est)
+                        break
+                    worst_m = check(law, xc, every)
+                    levels.append((nm, worst_m, n_pts[0]))
+                    if worst_m <= 0.5 * rtol:
+                        break
+                    checks.append((nm, worst_m))
+                    nm *= 2
+                    continue
+                m = model(rows, xk)
+                law = cls._assemble(loading, rtol, sig, rows, xk, m, beta, energy=False,
+                                    ghosts=False)
+                table = (rows, m, False)
+                inner = every[1:-1] if nm > 2 else every
+                worst_m = check(law, xc, inner)
                 checks.append((nm, worst_m))
-                levels.append((nm, worst_m, n_pts[0]))
+                levels.append((nm, worst_m, n_pts[0], "interior"))
                 if worst_m <= 0.5 * rtol:
-                    break
+                    table, law = ghosted()
+                    worst_m = check(law, xc, every)
+                    levels.append((nm, worst_m, n_pts[0]))
+                    if worst_m <= 0.5 * rtol:
+                        break
                 nm *= 2
         except _Budget:
             if strict or table is None:
@@ -491,8 +518,9 @@ class HistoryNormalLaw:
                     f"{max_seconds}) exhausted at rtol = {rtol} while refining {stage} "
                     f"({nm} rows intervals x {xk.size - 1} x intervals; x check error "
                     f"{worst_x:.2g}): loosen rtol or raise the budget") from None
-        hm, m = table
-        law = cls._assemble(loading, rtol, sig, hm, xk, m, beta, capped=n_capped[0] > 0)
+        hm, m, gh = table
+        law = cls._assemble(loading, rtol, sig, hm, xk, m, beta, capped=n_capped[0] > 0,
+                            ghosts=gh)
         ok = law._check_monotone()
         worst = worst_x + worst_m
         if n_capped[0]:
@@ -507,7 +535,7 @@ class HistoryNormalLaw:
                 UnloadingAboveLoadingWarning, stacklevel=2)
         law.info.update({"capped_points": int(n_capped[0])})
         law.info.update({"build_seconds": time.perf_counter() - t0, "loading_seconds": t_load,
-                         "history_seconds": time.perf_counter() - t1, "rows": hm.size - 2,
+                         "history_seconds": time.perf_counter() - t1, "rows": law._n_m + 1,
                          "x_knots": xk.size, "X": X, "model_points": n_pts[0],
                          "worst_error": float(worst), "worst_error_x": float(worst_x),
                          "worst_error_h_min": float(worst_m), "n_quad": n_quad, "n_t": n_t,
@@ -518,17 +546,21 @@ class HistoryNormalLaw:
         return law
 
     @classmethod
-    def _assemble(cls, loading, rtol, sig, hm, xk, m, beta, energy=True, capped=False):
+    def _assemble(cls, loading, rtol, sig, hm, xk, m, beta, energy=True, capped=False,
+                  ghosts=True):
         """The law from row data m (4, n_m + 3, n_knots) on the rows hm (uniform in v, the
-        first and the last a ghost row beyond the table) and the x knots xk."""
-        n_m, n_x = hm.size - 3, xk.size - 1
+        first and the last a ghost row beyond the table) and the x knots xk; ghosts=False:
+        m (4, n_m + 1, n_knots) on the table's rows only (not-a-knot at the table's ends:
+        the coarse levels of the build)."""
+        g = 1 if ghosts else 0
+        n_m, n_x = hm.size - 1 - 2 * g, xk.size - 1
         cv, cd, ch1 = _monotone_controls(*_spline_controls(np.stack([m[0], m[1]], 1)
                                                              ).transpose(1, 0, 2), xk)
         av, ad, ch2 = _monotone_controls(*_spline_controls(np.stack([m[2], m[3]], 1)
                                                              ).transpose(1, 0, 2), xk)
         # the spline through all rows; cells of the table's rows only (ghost cells dropped)
-        CF = np.concatenate([_cells(cv[1:-1], cd[1:-1], xk), _cells(av[1:-1], ad[1:-1], xk)],
-                            axis=2)
+        sl = slice(g, cv.shape[0] - g)
+        CF = np.concatenate([_cells(cv[sl], cd[sl], xk), _cells(av[sl], ad[sl], xk)], axis=2)
         CF = np.ascontiguousarray(CF.reshape(n_m * n_x, 32).T)
         dxk = np.diff(xk)
         w = float(dxk.min())
@@ -536,7 +568,7 @@ class HistoryNormalLaw:
         lut = np.clip(np.searchsorted(xk, (np.arange(n_lut + 1) + 0.5) * w, side="right") - 1,
                       0, n_x - 1).astype(np.intp)
         nxt = np.concatenate([xk[1:-1], [np.inf]])
-        hm = hm[1:-1]
+        hm = hm[g:hm.size - g]
         law = cls(loading=loading, rtol=rtol, sigma=sig, _hm0=float(hm[0]),
                   _span=float(hm[-1] - hm[0]), _beta=float(beta),
                   _X=float(xk[-1]), _xk=xk, _xinv=1.0 / dxk, _xinv_h=1.0 / (dxk * sig),
