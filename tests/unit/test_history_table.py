@@ -14,6 +14,8 @@ are exercised by the coarse real table at the end. Units: mm, MPa.
 """
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 from scipy.integrate import trapezoid
 import pytest
@@ -168,16 +170,22 @@ def test_bad_build_arguments_are_named():
             HistoryNormalLaw.elasto_plastic(s, mat, **{"rtol": 1e-3, **kw})
 
 
+@functools.lru_cache(maxsize=None)
+def _coarse_loading():
+    """Table 1 surface, psi = 1, and its coarse loading law (rtol 1e-2, n_quad 8)."""
+    from rough_contact.micro.asperity import AsperityMaterial
+    from rough_contact.surface import SpectralMoments
+    s = SpectralMoments(m00=0.0625, m20=8e-5, m02=8e-4, m40=1.04e-6, m04=1.04e-4)
+    mat = AsperityMaterial(E_star=1.14e5, psi=1.0).resolve(s)
+    return s, mat, NormalLaw.elasto_plastic(s, mat, rtol=1e-2, n_quad=8)
+
+
 def test_coarse_population_table_against_direct_sums_at_random_points():
     """A coarse table of the paper's Table 1 surface (rtol 1e-2, cheap sums n_quad 8): its
     error against the direct sums at random points -- not the build's own check points -- is
     within rtol, k >= 0 on the build's dense sample, and the build's bookkeeping is sane."""
     from rough_contact.micro import unloading as U
-    from rough_contact.micro.asperity import AsperityMaterial
-    from rough_contact.surface import SpectralMoments
-    s = SpectralMoments(m00=0.0625, m20=8e-5, m02=8e-4, m40=1.04e-6, m04=1.04e-4)
-    mat = AsperityMaterial(E_star=1.14e5, psi=1.0).resolve(s)
-    loading = NormalLaw.elasto_plastic(s, mat, rtol=1e-2, n_quad=8)
+    s, mat, loading = _coarse_loading()
     rtol = 1e-2
     law = HistoryNormalLaw.elasto_plastic(s, mat, rtol, loading=loading, n_quad=8, n_t=16,
                                           n_zeta=8, n_rows=3, n_x=2)
@@ -332,3 +340,25 @@ def test_without_area_same_p_k_dk():
     p, k, a = rev.evaluate_history(h, hm, area=False)
     assert a is None
     np.testing.assert_array_equal(p, law.loading.evaluate(h)[0])
+
+
+def test_budget_exhausted_on_a_coarse_level_returns_that_table_or_raises():
+    """The coarse row levels of the build have no ghost rows (not-a-knot at the table's
+    ends): with strict=False a budget that runs out there returns that table -- a usable law
+    (finite, k >= 0, the branch starting on the loading law) flagged as not converged;
+    strict=True raises and names the budget."""
+    s, mat, loading = _coarse_loading()
+    kw = dict(loading=loading, n_quad=8, n_t=16, n_zeta=8, n_rows=3, n_x=2)
+    law = HistoryNormalLaw.elasto_plastic(s, mat, 1e-3, strict=False, max_points=150, **kw)
+    info = law.info
+    assert not info["converged"] and info["levels"][-1][-1] == "interior"
+    assert info["worst_error_h_min"] > 0.5e-3 and info["k_nonnegative"]
+    rng = np.random.default_rng(2)
+    hm = rng.uniform(loading.h_min, loading.h_table_end, 4000)
+    h = hm + rng.uniform(0.0, 8.0, 4000) * s.rq
+    p, k, a, dk = law.evaluate_history(h, hm, curvature=True)
+    assert all(np.all(np.isfinite(v)) for v in (p, k, a, dk)) and np.all(k >= 0)
+    np.testing.assert_allclose(law.evaluate_history(hm + 1e-9 * s.rq, hm)[0],
+                               loading.evaluate(hm)[0], rtol=1e-6)
+    with pytest.raises(RuntimeError, match="max_points = 60"):
+        HistoryNormalLaw.elasto_plastic(s, mat, 1e-3, strict=True, max_points=60, **kw)
