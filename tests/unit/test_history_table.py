@@ -321,6 +321,9 @@ def test_repeated_h_min_is_remembered_bit_for_bit(curvature):
             if y is not None:
                 np.testing.assert_array_equal(x, y)
     assert law._memo["h_min"].p0 is not None           # the hot path was taken
+    # what is remembered is not part of the law's identity (checkpoint fingerprints)
+    from rough_contact.fingerprint import describe
+    assert describe(law) == describe(_synthetic(_rho, _drho, _la, _dla))
     hm[::3] -= 0.3 * SIG                               # changed in place: not the same h_min
     got = law.evaluate_history(h, hm, curvature)
     fresh = pickle.loads(pickle.dumps(law)).evaluate_history(h, hm, curvature)
