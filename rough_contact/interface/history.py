@@ -28,14 +28,20 @@ and ln(a/a0) likewise, over [h_lo, h_table_end] x [0, X]:
 * x: cubic Hermite on graded knots, with the model's own slopes (d rho/dx = -k sigma/p); the
   knots start uniform and every interval whose midpoint fails the check against the direct
   sums (``rough_contact.micro.unloading``) on the first rows is split (rho bends sharply at
-  x ~ 0.3-0.5 on the high rows: the knots crowd there). O(1) look-up by a uniform table of
-  cells no wider than the shortest interval.
+  x ~ 0.3-0.5 on the high rows: the knots crowd there); the halves of an interval that
+  failed by less than 8x the threshold are not checked again (error / 16 per halving, taken
+  as / 8). O(1) look-up by a uniform table of cells no wider than the shortest interval.
 * h_min: a uniform cubic B-spline in a row coordinate v, h_min = h_lo + span (v + beta v^2)/
   (1 + beta) (beta = 1: rows 3x denser at h_lo, where rho varies fastest with h_min), through
   rows uniform in v plus one ghost row beyond each end (not-a-knot conditions); the rows are
-  doubled until the row midpoints pass the check at every other x knot. Each half of rtol goes
-  to one direction. Values between rows are a convex combination (B-spline weights >= 0) of
-  four control rows, each a cubic Hermite curve in x.
+  doubled until the row midpoints pass the check at every other x knot. The coarse levels
+  have no ghost rows (not-a-knot at the table's ends) and are judged at the interior row
+  midpoints; a level that passes there gets its ghost rows and is checked at every row
+  midpoint. Once two checks have shown an error ratio >= 8 per doubling, the next level's
+  error is estimated as the last one / 8 (/ 16 for a cubic spline); if that passes, a check
+  at every fourth x knot confirms it. Each half of rtol goes to one direction. Values between
+  rows are a convex combination (B-spline weights >= 0) of four control rows, each a cubic
+  Hermite curve in x.
 * monotone by construction: every control row's Hermite data is projected onto the set of
   non-increasing curves (running minimum of the values, slopes clipped to <= 0 and scaled into
   the Fritsch-Carlson circle), so rho, and with it p, is non-increasing in h at every h_min:
