@@ -182,13 +182,25 @@ def _poly(cc, tm, tx, second=False):
     """rho, d rho/dtx (and d2 rho/dtx2) and ln(a/a0) of the gathered cell coefficients cc
     (32, n) at (tm, tx) (Horner in tm for both tables at once, then in tx); ln(a/a0) is None
     if cc holds rho's 16 coefficients only."""
+    return _tx_horner(_tm_horner(cc, tm), tx, second)
+
+
+def _tm_horner(cc, tm):
+    """The cells' polynomials in tx (k, 4, n) at the row coordinates tm (n,): Horner in tm of
+    the gathered coefficients cc (16 k, n), k = 2 (rho, ln a/a0) or 1 (rho)."""
     c4 = cc.reshape(-1, 4, 4, tm.size)                    # [k, p, q, point]
     g = c4[:, 3] * tm
     g += c4[:, 2]
     g *= tm
     g += c4[:, 1]
     g *= tm
-    g += c4[:, 0]                                         # (2, 4, n): polynomials in tx
+    g += c4[:, 0]
+    return g
+
+
+def _tx_horner(g, tx, second=False):
+    """rho, d rho/dtx (and d2 rho/dtx2) and ln(a/a0) (None if k = 1) of the polynomials in tx
+    g (k, 4, n) at tx (n,)."""
     v = g[:, 3] * tx
     v += g[:, 2]
     v *= tx
@@ -703,12 +715,15 @@ class HistoryNormalLaw:
                 ug = un + s
                 p0, a0 = memo.p0.take(ug), memo.a0.take(ug)
                 base, tm = memo.base.take(ug), memo.tm.take(ug)
+                kept = (memo, ug)
             else:
                 # one loading evaluation per point: at h, or at h_min where unloading (p0, a0)
                 load_block(np.where(unm, mb, hb), *ob4(ob))
                 p0, a0 = ob[0].take(un), ob[2].take(un)
                 base, tm = self._row_cell(mb.take(un))
-            self._unload(hb.take(un), mb.take(un), p0, a0, base, tm, ob, un, curvature, area)
+                kept = None
+            self._unload(hb.take(un), mb.take(un), p0, a0, base, tm, ob, un, curvature, area,
+                         kept)
         res = [v.reshape(shape) for v in out]
         if not area:
             res[2] = None
@@ -737,6 +752,8 @@ class HistoryNormalLaw:
                 e = min(s + _BLOCK, hm.size)
                 self.loading._eval_block(hm[s:e], p0[s:e], np.empty(e - s), a0[s:e], None)
             memo.base, memo.tm = self._row_cell(hm)
+            memo.cell = np.full(hm.size, -1, dtype=np.intp)
+            memo.G = np.empty((2, 4, hm.size))
             memo.p0, memo.a0 = p0, a0
         return memo
 
@@ -749,10 +766,13 @@ class HistoryNormalLaw:
         i *= self._xinv.size
         return i, um
 
-    def _unload(self, h, hm, p0, a0, base, tm, out, idx, curvature, area=True):
+    def _unload(self, h, hm, p0, a0, base, tm, out, idx, curvature, area=True, kept=None):
         """The unloading branch at the points idx (h > h_min, h_min < h_table_end) of out;
         p0, a0: the loading law at h_min; base, tm: ``_row_cell(h_min)``; ``area=False``:
-        out[2] is left as it is (rho's cells only)."""
+        out[2] is left as it is (rho's cells only); kept = (memo, point indices): the
+        points' polynomials in tx are taken from the memo where the point is in the same
+        cell as at its last evaluation (the same values: the same cell and tm), else made
+        and kept there."""
         sig = self.sigma
         x = h - hm
         x *= 1.0 / sig
@@ -761,8 +781,18 @@ class HistoryNormalLaw:
         j += xc >= self._xnext.take(j)
         tx = xc - self._xk.take(j)
         tx *= self._xinv.take(j)
-        CF = self._CF if area else self._CF[:16]
-        r = _poly(CF.take(base + j, axis=1), tm, tx, second=curvature)
+        c = base + j
+        if kept is None:
+            g = _tm_horner((self._CF if area else self._CF[:16]).take(c, axis=1), tm)
+        else:
+            memo, ug = kept
+            miss = np.flatnonzero(memo.cell.take(ug) != c)
+            if miss.size:
+                um, cm = ug.take(miss), c.take(miss)
+                memo.G[:, :, um] = _tm_horner(self._CF.take(cm, axis=1), tm.take(miss))
+                memo.cell[um] = cm
+            g = memo.G.take(ug, axis=2) if area else memo.G[0].take(ug, axis=1)[None]
+        r = _tx_horner(g, tx, second=curvature)
         p = np.exp(r[0])
         p *= p0
         s = self._xinv_h.take(j)
@@ -843,11 +873,13 @@ class _HminMemo:
     """What the unloading points of one h_min array need of h_min alone: p_load(h_min), A0,
     first cell index and row coordinate (``HistoryNormalLaw._row_cell``); None until filled."""
 
-    __slots__ = ("h_min", "p0", "a0", "base", "tm")
+    __slots__ = ("h_min", "p0", "a0", "base", "tm", "cell", "G")
 
     def __init__(self, h_min):
         self.h_min = h_min.copy()
         self.p0 = self.a0 = self.base = self.tm = None
+        self.cell = None    # (n,) the cell whose polynomials in tx G holds (-1: none)
+        self.G = None       # (2, 4, n) rho's and ln(a/a0)'s polynomials in tx of that cell
 
 
 class UnloadingAboveLoadingWarning(UserWarning):

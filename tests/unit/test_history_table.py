@@ -303,7 +303,8 @@ def _mixed_points(law, n, seed):
 @pytest.mark.parametrize("curvature", [False, True])
 def test_repeated_h_min_is_remembered_bit_for_bit(curvature):
     """A Newton loop calls with the same committed h_min every iteration: from the second
-    call on, what unloading points need of h_min alone is remembered. Every call must give
+    call on, what unloading points need of h_min alone is remembered, and a point's cell
+    polynomial in x while it stays in its x cell. Every call must give
     exactly what a law that never saw this h_min gives (a fresh copy), for changing h, with
     and without A/A0, over several evaluation blocks; and an h_min array changed in place
     must not be mistaken for the remembered one."""
@@ -312,15 +313,23 @@ def test_repeated_h_min_is_remembered_bit_for_bit(curvature):
     n = 2 * H._BLOCK + 777
     h, hm = _mixed_points(law, n, 7)
     rng = np.random.default_rng(8)
-    for it, area in enumerate([False, False, True, True, False, True]):
+    kept = []
+    for it, area in enumerate([False, False, True, True, False, True, True]):
         hh = h + rng.normal(0.0, 0.05, n) * SIG * (it > 0)
+        memo = law._memo.get("h_min")
+        before = None if memo is None or memo.cell is None else memo.cell.copy()
         got = law.evaluate_history(hh, hm, curvature, area=area)
+        if before is not None:          # points whose x cell was kept, and points that moved
+            after = law._memo["h_min"].cell
+            kept.append((np.count_nonzero((after == before) & (before >= 0)),
+                          np.count_nonzero((after != before) & (before >= 0))))
         fresh = pickle.loads(pickle.dumps(law)).evaluate_history(hh, hm, curvature, area=area)
         assert (got[2] is None) == (not area) and (fresh[2] is None) == (not area)
         for x, y in zip(got, fresh):
             if y is not None:
                 np.testing.assert_array_equal(x, y)
     assert law._memo["h_min"].p0 is not None           # the hot path was taken
+    assert all(k > n / 6 and c > 0 for k, c in kept[1:])   # cells kept and cells changed
     # what is remembered is not part of the law's identity (checkpoint fingerprints)
     from rough_contact.fingerprint import describe
     assert describe(law) == describe(_synthetic(_rho, _drho, _la, _dla))
