@@ -490,8 +490,8 @@ class HistoryNormalLaw:
                 def ghosted():
                     hm = _row_h(np.arange(-1, nm + 2) / nm, hL, span, beta)
                     m = model(hm, xk)
-                    return (hm, m, True), cls._assemble(loading, rtol, sig, hm, xk, m, beta,
-                                                  energy=False)
+                    law = cls._assemble(loading, rtol, sig, hm, xk, m, beta, energy=False)
+                    return (hm, m, True), law
 
                 every = np.arange(nm)
                 # embedded estimate: the error of the last level / 16 (rows doubled, cubic),
@@ -670,9 +670,10 @@ class HistoryNormalLaw:
         None; p, k, dk/dh unchanged): a Newton iteration needs p and k only.
 
         What an unloading point needs of its h_min alone (p_load(h_min), A0, the row cell and
-        its local coordinate) is remembered for the last h_min array seen (a Newton loop calls
-        with the same committed h_min every iteration): the values are those of a first call,
-        bit for bit, only not recomputed."""
+        its local coordinate), and its cell polynomials in x while it stays in its x cell, are
+        remembered for the last h_min array seen (a Newton loop calls with the same committed
+        h_min every iteration): the values are those of a first call, bit for bit, only not
+        recomputed."""
         h = np.asarray(h, dtype=float)
         hmn = np.asarray(h_min, dtype=float)
         if np.isnan(h).any() or np.isnan(hmn).any():
