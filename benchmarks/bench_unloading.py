@@ -2,9 +2,14 @@
 
 Prints three tables:
   1. sphere limit: residual ratios of the consistent construction vs the (unverified) EKK fit;
-  2. throughput on 1e5 points: NormalLaw.evaluate(h) (reversible), HistoryNormalLaw
-     .evaluate_history(h, h_min) (half the points unloading), and the whole InterfaceLaw
-     (friction on) with the reversible and the history normal law;
+  2. throughput on 1e5 points (half of them unloading): HistoryNormalLaw.evaluate_history
+     against NormalLaw.evaluate (reversible), with all outputs (p, k, A/A0), without A/A0
+     (against a NormalLaw without area) and with dk/dh; each for Newton-like calls (the same
+     h_min, h moved between calls by N(0, 1e-3 sigma); also 0.1 sigma with all outputs: the
+     law remembers what h_min alone decides, and a point's cell polynomial in x while it
+     stays in its x cell) and for a first call with a new h_min; and the whole InterfaceLaw
+     (friction on) with the reversible and the history normal law (the same committed
+     state, the normal jump moved by 1e-3 sigma between calls);
   3. (--table) the build of the loading table and of the history table: wall and CPU time
      (the machine is shared: CPU time is the figure that does not depend on the other jobs),
      direct-sum points, rows x x-knots, the build's own check errors (x direction, h_min
@@ -24,7 +29,9 @@ Usage: .venv/bin/python benchmarks/bench_unloading.py [--rtol 1e-3] [--psi 1.0] 
        [--convergence] [--n-quad 16] [--n-t 16] [--max-points 20000] [--random-rows 12]
 """
 import argparse
+import dataclasses
 import math
+import pickle
 import time
 
 import numpy as np
@@ -135,6 +142,10 @@ def main():
               f"(converged: {inf['converged']}); k >= 0 on 2e5 points: {inf['k_nonnegative']}; "
               f"monotone projection changed {inf['monotone_projection_changes']} data")
         print(f"total (loading + history): {t_load + tb:.1f} s wall, {c_load + cb:.1f} s CPU")
+        print("refinement (stage, check error, direct-sum points so far[, sparse check, "
+              "embedded estimate]):", "; ".join(
+                  " ".join(f"{v:.3g}" if isinstance(v, float) else str(v) for v in lv)
+                  for lv in inf["levels"]))
         sig = S1.rq
         print(f"table vs direct sums at {4 * a.random_rows} random points (x <= 4): max, "
               "median relative error of the worst of p, k, A/A0")
@@ -161,22 +172,64 @@ def main():
     rng = np.random.default_rng(0)
     h = rng.uniform(load.h_min, load.h_max, n)
     hm = h - rng.uniform(-0.5, 0.5, n) * (load.h_max - load.h_min)   # half the points unloading
-    print(f"\n{'throughput on 1e5 points (CPU time, best of 40)':48s} points/s   % of reversible")
-    r_rev, r_his = rates([lambda: load.evaluate(h), lambda: law.evaluate_history(h, hm)], n)
-    print(f"{'NormalLaw.evaluate(h)':48s} {r_rev:9.3g}   100")
-    print(f"{'HistoryNormalLaw.evaluate_history(h, h_min)':48s} {r_his:9.3g}   "
-          f"{100 * r_his / r_rev:3.0f}")
+    # Newton-like calls: the same h_min, h moved between calls by N(0, step sigma) (8 arrays
+    # in turn); late iterations move by ~1e-3 sigma, a predictor by more
+    sig = S1.rq
+
+    def moving(step, k=8):
+        hs = [h + rng.normal(0.0, step * sig, n) for _ in range(k)]
+        it = [0]
+
+        def nxt():
+            it[0] += 1
+            return hs[it[0] % k]
+        return nxt
+
+    print(f"\n{'throughput on 1e5 points (CPU time, best of 40)':56s} points/s   % of reversible")
+    cold = pickle.loads(pickle.dumps(law))         # a copy that never remembers h_min
+    # one copy per row below: what a law remembers is that of its own last call
+    lw = [pickle.loads(pickle.dumps(law)) for _ in range(4)]
+
+    def first(**kw):
+        cold._memo.clear()
+        return cold.evaluate_history(h, hm, **kw)
+
+    load_na = dataclasses.replace(load, has_area=False)
+    m = [moving(1e-3) for _ in range(6)] + [moving(0.1)]
+    rows = [("NormalLaw.evaluate(h)", lambda: load.evaluate(m[0]()), None),
+            ("evaluate_history, same h_min, h moved 1e-3 sigma",
+             lambda: lw[0].evaluate_history(m[1](), hm), 0),
+            ("evaluate_history, same h_min, h moved 0.1 sigma",
+             lambda: lw[1].evaluate_history(m[6](), hm), 0),
+            ("evaluate_history, first call with this h_min", first, 0),
+            ("NormalLaw without area", lambda: load_na.evaluate(m[2]()), None),
+            ("evaluate_history(area=False), same h_min, 1e-3 sigma",
+             lambda: lw[2].evaluate_history(m[3](), hm, area=False), 4),
+            ("evaluate_history(area=False), first call", lambda: first(area=False), 4),
+            ("NormalLaw.evaluate(h, curvature=True)", lambda: load.evaluate(m[4](), True), None),
+            ("evaluate_history(curvature=True), same h_min, 1e-3 sigma",
+             lambda: lw[3].evaluate_history(m[5](), hm, True), 7),
+            ("evaluate_history(curvature=True), first call", lambda: first(curvature=True), 7)]
+    r = rates([f for _, f, _ in rows], n)
+    for (name, _, ref), ri in zip(rows, r):
+        print(f"{name:56s} {ri:9.3g}   {100 * ri / r[ref] if ref is not None else 100:3.0f}")
     fr = dict(tangential=TangentialStiffness((0.7, 1.0)),
               friction=IsotropicSlipHardening(0.4, 0.5, 275.0), h0=0.0)
-    jump = np.stack([h, rng.normal(0, 1e-5, n), rng.normal(0, 1e-5, n)], 1)
+    jumps = [np.stack([h + rng.normal(0.0, 1e-3 * sig, n), rng.normal(0, 1e-5, n),
+                       rng.normal(0, 1e-5, n)], 1) for _ in range(8)]
     L0 = InterfaceLaw(normal=load, **fr)
     s0 = L0.initial_state(n)
     L1 = InterfaceLaw(normal=law, **fr)
     s1 = L1.initial_state(n)
     s1.h_min[:] = hm
-    r0, r1 = rates([lambda: L0.evaluate(jump, s0), lambda: L1.evaluate(jump, s1)], n, 10)
-    print(f"{'InterfaceLaw.evaluate, reversible normal':48s} {r0:9.3g}   100")
-    print(f"{'InterfaceLaw.evaluate, normal with memory':48s} {r1:9.3g}   {100 * r1 / r0:3.0f}")
+    c0, c1 = [0], [0]
+
+    def step(L, s, c):
+        c[0] += 1
+        return L.evaluate(jumps[c[0] % 8], s)
+    r0, r1 = rates([lambda: step(L0, s0, c0), lambda: step(L1, s1, c1)], n, 10)
+    print(f"{'InterfaceLaw.evaluate, reversible normal':56s} {r0:9.3g}   100")
+    print(f"{'InterfaceLaw.evaluate, normal with memory':56s} {r1:9.3g}   {100 * r1 / r0:3.0f}")
 
 
 if __name__ == "__main__":

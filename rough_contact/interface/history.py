@@ -28,14 +28,20 @@ and ln(a/a0) likewise, over [h_lo, h_table_end] x [0, X]:
 * x: cubic Hermite on graded knots, with the model's own slopes (d rho/dx = -k sigma/p); the
   knots start uniform and every interval whose midpoint fails the check against the direct
   sums (``rough_contact.micro.unloading``) on the first rows is split (rho bends sharply at
-  x ~ 0.3-0.5 on the high rows: the knots crowd there). O(1) look-up by a uniform table of
-  cells no wider than the shortest interval.
+  x ~ 0.3-0.5 on the high rows: the knots crowd there); the halves of an interval that
+  failed by less than 8x the threshold are not checked again (error / 16 per halving, taken
+  as / 8). O(1) look-up by a uniform table of cells no wider than the shortest interval.
 * h_min: a uniform cubic B-spline in a row coordinate v, h_min = h_lo + span (v + beta v^2)/
   (1 + beta) (beta = 1: rows 3x denser at h_lo, where rho varies fastest with h_min), through
   rows uniform in v plus one ghost row beyond each end (not-a-knot conditions); the rows are
-  doubled until the row midpoints pass the check at every other x knot. Each half of rtol goes
-  to one direction. Values between rows are a convex combination (B-spline weights >= 0) of
-  four control rows, each a cubic Hermite curve in x.
+  doubled until the row midpoints pass the check at every other x knot. The coarse levels
+  have no ghost rows (not-a-knot at the table's ends) and are judged at the interior row
+  midpoints; a level that passes there gets its ghost rows and is checked at every row
+  midpoint. Once two checks have shown an error ratio >= 8 per doubling, the next level's
+  error is estimated as the last one / 8 (/ 16 for a cubic spline); if that passes, a check
+  at every fourth x knot confirms it. Each half of rtol goes to one direction. Values between
+  rows are a convex combination (B-spline weights >= 0) of four control rows, each a cubic
+  Hermite curve in x.
 * monotone by construction: every control row's Hermite data is projected onto the set of
   non-increasing curves (running minimum of the values, slopes clipped to <= 0 and scaled into
   the Fritsch-Carlson circle), so rho, and with it p, is non-increasing in h at every h_min:
@@ -51,6 +57,7 @@ and ln(a/a0) likewise, over [h_lo, h_table_end] x [0, X]:
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 import warnings
@@ -113,7 +120,10 @@ class ReversalStiffnessProtocol(Protocol):
 _B = np.array([[1.0, -3.0, 3.0, -1.0], [4.0, 0.0, -6.0, 3.0], [1.0, 3.0, 3.0, -3.0],
                [0.0, 0.0, 0.0, 1.0]]) / 6.0
 _GRADING = 1.0       # row grading beta: row spacing grows 1 + 2 beta = 3x from h_lo to h_end
-_BLOCK = 8192        # points per evaluation block (about half of them on the unloading branch)
+_HALF_X = 1.0 / 8.0  # estimated error ratio of a halved x cell (1/16 for cubic Hermite)
+_HALF_ROWS = 1.0 / 8.0       # estimated error ratio of doubled rows (1/16 for the cubic spline)
+_HALF_ROWS_RATE = 8.0        # ... used once two checks have shown at least this ratio
+_BLOCK = 32768       # points per evaluation block: fewer numpy calls per point (8192: 10-15 % slower)
 
 
 def _row_h(v, h0, span, beta):
@@ -191,14 +201,27 @@ def _cells(v, d, xk):
 
 def _poly(cc, tm, tx, second=False):
     """rho, d rho/dtx (and d2 rho/dtx2) and ln(a/a0) of the gathered cell coefficients cc
-    (32, n) at (tm, tx) (Horner in tm for both tables at once, then in tx)."""
-    c4 = cc.reshape(2, 4, 4, -1)                          # [k, p, q, point]
+    (32, n) at (tm, tx) (Horner in tm for both tables at once, then in tx); ln(a/a0) is None
+    if cc holds rho's 16 coefficients only."""
+    return _tx_horner(_tm_horner(cc, tm), tx, second)
+
+
+def _tm_horner(cc, tm):
+    """The cells' polynomials in tx (k, 4, n) at the row coordinates tm (n,): Horner in tm of
+    the gathered coefficients cc (16 k, n), k = 2 (rho, ln a/a0) or 1 (rho)."""
+    c4 = cc.reshape(-1, 4, 4, tm.size)                    # [k, p, q, point]
     g = c4[:, 3] * tm
     g += c4[:, 2]
     g *= tm
     g += c4[:, 1]
     g *= tm
-    g += c4[:, 0]                                         # (2, 4, n): polynomials in tx
+    g += c4[:, 0]
+    return g
+
+
+def _tx_horner(g, tx, second=False):
+    """rho, d rho/dtx (and d2 rho/dtx2) and ln(a/a0) (None if k = 1) of the polynomials in tx
+    g (k, 4, n) at tx (n,)."""
     v = g[:, 3] * tx
     v += g[:, 2]
     v *= tx
@@ -209,11 +232,12 @@ def _poly(cc, tm, tx, second=False):
     dv += 2.0 * g[0, 2]
     dv *= tx
     dv += g[0, 1]
+    la = v[1] if v.shape[0] == 2 else None
     if second:
         d2 = g[0, 3] * (6.0 * tx)
         d2 += 2.0 * g[0, 2]
-        return v[0], dv, v[1], d2
-    return v[0], dv, v[1]
+        return v[0], dv, la, d2
+    return v[0], dv, la
 
 
 def _hermite_mid(v, d, xk):
@@ -270,6 +294,13 @@ class HistoryNormalLaw:
     _IL: float = 0.0                    # int exp(rho(row 0, x)) dx incl. taper [-]
     _capped: bool = False               # the sums went above the loading branch: cap by it
     info: dict = field(default_factory=dict, compare=False)   # build statistics, not identity
+    _memo: dict = field(default_factory=dict, compare=False, repr=False)  # h_min data, not identity
+
+    def __getstate__(self):
+        """Pickle without the remembered h_min data."""
+        state = dict(self.__dict__)
+        state.pop("_memo", None)
+        return state
 
     def __setstate__(self, state):
         """Unpickle; a table pickled by the session-3 code (uniform bicubic grid, keys _C, _dm)
@@ -280,6 +311,7 @@ class HistoryNormalLaw:
                              "cannot be read; delete the cached file and rebuild the law")
         for key, value in state.items():
             object.__setattr__(self, key, value)
+        object.__setattr__(self, "_memo", {})
 
     # ------------------------------------------------------------ NormalLaw interface
     @property
@@ -373,7 +405,9 @@ class HistoryNormalLaw:
 
         def model(hms, xs):
             """(rho, d rho/dx, ln a - ln a0, d ln a/dx) (4, len(hms), len(xs)), cached per
-            point; one direct-sum call per row for the points not yet known."""
+            point; one direct-sum call per row for the points not yet known (the sums at a
+            point do not depend on the other points of the call), the row's start (u = 0:
+            p0, a0) in its first call only."""
             out = np.empty((4, len(hms), len(xs)))
             for i, hm in enumerate(hms):
                 row = cache.setdefault(round(float((hm - hL) / (hE - hL)), 12), {})
@@ -381,14 +415,21 @@ class HistoryNormalLaw:
                 if need:
                     if time.perf_counter() - t1 > max_seconds or n_pts[0] > max_points:
                         raise _Budget()
-                    uu = np.concatenate([[0.0], np.asarray(need) * sig])
+                    start = row.get("start")
+                    uu = np.asarray(need) * sig
+                    if start is None:
+                        uu = np.concatenate([[0.0], uu])
                     p, k, a, da = U._row_sums(surface, mat, float(hm), uu, n_quad, n_t, n_zeta)
                     n_pts[0] += uu.size
                     p = np.maximum(p, 1e-300)
                     a = np.maximum(a, 1e-300)
-                    vals = np.stack([np.log(p[1:] / p[0]), -k[1:] / p[1:] * sig,
-                                     np.log(a[1:] / a[0]), -da[1:] / a[1:] * sig])
-                    n_capped[0] += _count_above_loading(vals[0], loading, float(hm), uu[1:],
+                    if start is None:
+                        start = row["start"] = (p[0], a[0])
+                        p, k, a, da = p[1:], k[1:], a[1:], da[1:]
+                        uu = uu[1:]
+                    vals = np.stack([np.log(p / start[0]), -k / p * sig,
+                                     np.log(a / start[1]), -da / a * sig])
+                    n_capped[0] += _count_above_loading(vals[0], loading, float(hm), uu,
                                                         rtol, tail, worst=cap_worst)
                     for x, col in zip(need, vals.T):
                         row[round(float(x), 12)] = tuple(float(c) for c in col)
@@ -408,6 +449,7 @@ class HistoryNormalLaw:
         xk = np.linspace(0.0, X, int(n_x) + 1)
         worst_x = worst_m = np.inf
         table = None
+        levels: list = []               # (row intervals or "x", check error, points so far)
         stage = "x"
         try:
             # 1. graded x knots: split every x cell whose midpoint fails on any of the first rows
@@ -430,6 +472,13 @@ class HistoryNormalLaw:
                         worst_x = max(worst_x, e)
                         if e > 0.5 * rtol:
                             split.append(xm[j])
+                            # the halves of a cubic Hermite cell with exact slopes: error
+                            # / 16; taken as / 8: halves of a cell within 8x of the
+                            # threshold are not checked
+                            if e * _HALF_X <= 0.5 * rtol:
+                                for mid in (0.5 * (xk[j] + xm[j]), 0.5 * (xm[j] + xk[j + 1])):
+                                    passed.add(round(float(mid), 12))
+                                worst_pass = max(worst_pass, e * _HALF_X)
                         else:
                             passed.add(round(float(xm[j]), 12))
                             worst_pass = max(worst_pass, e)
@@ -439,22 +488,67 @@ class HistoryNormalLaw:
             # 2. rows: doubled until the row midpoints pass at every other x knot (and the
             #    last); the checked points become knots of the next rows if they fail
             stage = "rows"
+            levels.append(("x", worst_x, n_pts[0]))
             xc = xk[np.unique(np.r_[np.arange(0, xk.size, 2), xk.size - 1])]
+            xs = xk[np.unique(np.r_[np.arange(0, xk.size, 4), xk.size - 1])]    # sparse
+            checks: list = []               # full checks (nm, error)
             while True:
-                # rows uniform in v, with one ghost row beyond each end (interior spline
-                # conditions at the table's ends)
-                hm = _row_h(np.arange(-1, nm + 2) / nm, hL, span, beta)
-                m = model(hm, xk)
-                table = (hm, m)
+                # rows uniform in v; the coarse levels without ghost rows (not-a-knot at the
+                # table's ends) and checked at the interior row midpoints; a candidate for
+                # the table gets one ghost row beyond each end (interior spline conditions at
+                # the ends: the end intervals' error was 3x the interior's without them) and
+                # is checked at every row midpoint
+                v = np.arange(nm + 1) / nm
+                rows = _row_h(v, hL, span, beta)
                 hmid = _row_h((np.arange(nm) + 0.5) / nm, hL, span, beta)
-                ref = model(hmid, xc)
-                law = cls._assemble(loading, rtol, sig, hm, xk, m, beta, energy=False)
-                H = np.repeat(hmid, xc.size)
-                Xq = np.tile(xc, hmid.size)
-                r, dr, la = law._rho(H, Xq)
-                worst_m = _rel_errors(r, dr, la, [q.ravel() for q in ref[:3]], tail)
+
+                def check(law, xq, mids):
+                    hq = hmid[mids]
+                    r, dr, la = law._rho(np.repeat(hq, xq.size), np.tile(xq, hq.size))
+                    ref = model(hq, xq)
+                    return _rel_errors(r, dr, la, [q.ravel() for q in ref[:3]], tail)
+
+                def ghosted():
+                    hm = _row_h(np.arange(-1, nm + 2) / nm, hL, span, beta)
+                    m = model(hm, xk)
+                    law = cls._assemble(loading, rtol, sig, hm, xk, m, beta, energy=False)
+                    return (hm, m, True), law
+
+                every = np.arange(nm)
+                # embedded estimate: the error of the last level / 16 (rows doubled, cubic),
+                # taken as / 8, once the last two checks have shown that rate (>= 8); if it
+                # passes, the table's check at every fourth x knot only confirms it
+                est = None
+                if len(checks) >= 2 and checks[-2][1] >= _HALF_ROWS_RATE * checks[-1][1]:
+                    est = checks[-1][1] * _HALF_ROWS
+                if est is not None and est <= 0.5 * rtol:
+                    table, law = ghosted()
+                    worst_m = check(law, xs, every)
+                    levels.append((nm, worst_m, n_pts[0], "sparse", est))
+                    if worst_m <= 0.5 * rtol:
+                        worst_m = max(worst_m, est)
+                        break
+                    worst_m = check(law, xc, every)
+                    levels.append((nm, worst_m, n_pts[0]))
+                    if worst_m <= 0.5 * rtol:
+                        break
+                    checks.append((nm, worst_m))
+                    nm *= 2
+                    continue
+                m = model(rows, xk)
+                law = cls._assemble(loading, rtol, sig, rows, xk, m, beta, energy=False,
+                                    ghosts=False)
+                table = (rows, m, False)
+                inner = every[1:-1] if nm > 2 else every
+                worst_m = check(law, xc, inner)
+                checks.append((nm, worst_m))
+                levels.append((nm, worst_m, n_pts[0], "interior"))
                 if worst_m <= 0.5 * rtol:
-                    break
+                    table, law = ghosted()
+                    worst_m = check(law, xc, every)
+                    levels.append((nm, worst_m, n_pts[0]))
+                    if worst_m <= 0.5 * rtol:
+                        break
                 nm *= 2
         except _Budget:
             if strict or table is None:
@@ -463,8 +557,9 @@ class HistoryNormalLaw:
                     f"{max_seconds}) exhausted at rtol = {rtol} while refining {stage} "
                     f"({nm} rows intervals x {xk.size - 1} x intervals; x check error "
                     f"{worst_x:.2g}): loosen rtol or raise the budget") from None
-        hm, m = table
-        law = cls._assemble(loading, rtol, sig, hm, xk, m, beta, capped=n_capped[0] > 0)
+        hm, m, gh = table
+        law = cls._assemble(loading, rtol, sig, hm, xk, m, beta, capped=n_capped[0] > 0,
+                            ghosts=gh)
         ok = law._check_monotone()
         worst = worst_x + worst_m
         if n_capped[0]:
@@ -479,27 +574,32 @@ class HistoryNormalLaw:
                 UnloadingAboveLoadingWarning, stacklevel=2)
         law.info.update({"capped_points": int(n_capped[0])})
         law.info.update({"build_seconds": time.perf_counter() - t0, "loading_seconds": t_load,
-                         "history_seconds": time.perf_counter() - t1, "rows": hm.size - 2,
+                         "history_seconds": time.perf_counter() - t1, "rows": law._n_m + 1,
                          "x_knots": xk.size, "X": X, "model_points": n_pts[0],
                          "worst_error": float(worst), "worst_error_x": float(worst_x),
                          "worst_error_h_min": float(worst_m), "n_quad": n_quad, "n_t": n_t,
+                         "levels": levels,
                          "n_zeta": n_zeta,
                          "k_nonnegative": ok, "reversible": False,
                          "converged": bool(worst_x <= 0.5 * rtol and worst_m <= 0.5 * rtol)})
         return law
 
     @classmethod
-    def _assemble(cls, loading, rtol, sig, hm, xk, m, beta, energy=True, capped=False):
+    def _assemble(cls, loading, rtol, sig, hm, xk, m, beta, energy=True, capped=False,
+                  ghosts=True):
         """The law from row data m (4, n_m + 3, n_knots) on the rows hm (uniform in v, the
-        first and the last a ghost row beyond the table) and the x knots xk."""
-        n_m, n_x = hm.size - 3, xk.size - 1
+        first and the last a ghost row beyond the table) and the x knots xk; ghosts=False:
+        m (4, n_m + 1, n_knots) on the table's rows only (not-a-knot at the table's ends:
+        the coarse levels of the build)."""
+        g = 1 if ghosts else 0
+        n_m, n_x = hm.size - 1 - 2 * g, xk.size - 1
         cv, cd, ch1 = _monotone_controls(*_spline_controls(np.stack([m[0], m[1]], 1)
                                                              ).transpose(1, 0, 2), xk)
         av, ad, ch2 = _monotone_controls(*_spline_controls(np.stack([m[2], m[3]], 1)
                                                              ).transpose(1, 0, 2), xk)
         # the spline through all rows; cells of the table's rows only (ghost cells dropped)
-        CF = np.concatenate([_cells(cv[1:-1], cd[1:-1], xk), _cells(av[1:-1], ad[1:-1], xk)],
-                            axis=2)
+        sl = slice(g, cv.shape[0] - g)
+        CF = np.concatenate([_cells(cv[sl], cd[sl], xk), _cells(av[sl], ad[sl], xk)], axis=2)
         CF = np.ascontiguousarray(CF.reshape(n_m * n_x, 32).T)
         dxk = np.diff(xk)
         w = float(dxk.min())
@@ -507,7 +607,7 @@ class HistoryNormalLaw:
         lut = np.clip(np.searchsorted(xk, (np.arange(n_lut + 1) + 0.5) * w, side="right") - 1,
                       0, n_x - 1).astype(np.intp)
         nxt = np.concatenate([xk[1:-1], [np.inf]])
-        hm = hm[1:-1]
+        hm = hm[g:hm.size - g]
         law = cls(loading=loading, rtol=rtol, sigma=sig, _hm0=float(hm[0]),
                   _span=float(hm[-1] - hm[0]), _beta=float(beta),
                   _X=float(xk[-1]), _xk=xk, _xinv=1.0 / dxk, _xinv_h=1.0 / (dxk * sig),
@@ -584,9 +684,17 @@ class HistoryNormalLaw:
         return bool(np.all(k >= 0.0))
 
     # ------------------------------------------------------------ evaluation
-    def evaluate_history(self, h, h_min, curvature: bool = False):
+    def evaluate_history(self, h, h_min, curvature: bool = False, area: bool = True):
         """(p [MPa], k = -dp/dh|_{h_min} [MPa/mm], A/A0 [-][, dk/dh [MPa/mm^2]]) at
-        separations h after the smallest separation h_min (broadcast; h <= h_min: loading)."""
+        separations h after the smallest separation h_min (broadcast; h <= h_min: loading;
+        h_min >= h_table_end: the loading law at h). ``area=False`` skips A/A0 (returned as
+        None; p, k, dk/dh unchanged): a Newton iteration needs p and k only.
+
+        What an unloading point needs of its h_min alone (p_load(h_min), A0, the row cell and
+        its local coordinate), and its cell polynomials in x while it stays in its x cell, are
+        remembered for the last h_min array seen (a Newton loop calls with the same committed
+        h_min every iteration): the values are those of a first call, bit for bit, only not
+        recomputed."""
         h = np.asarray(h, dtype=float)
         hmn = np.asarray(h_min, dtype=float)
         if np.isnan(h).any() or np.isnan(hmn).any():
@@ -595,42 +703,136 @@ class HistoryNormalLaw:
         shape = h.shape
         h, hmn = h.ravel(), hmn.ravel()
         if self._CF is None:                      # reversible: h_min has no effect
-            return tuple(v.reshape(shape) for v in self.loading.evaluate(h, curvature))
-        # one loading evaluation per point, at min(h, h_min): the loading branch where h <=
-        # h_min, else the branch's start p0 = p_load(h_min), a0; in blocks that stay in cache
+            res = [v.reshape(shape) for v in self.loading.evaluate(h, curvature)]
+            if not area:
+                res[2] = None
+            return tuple(res)
         n = h.size
         out = [np.empty(n) for _ in range(4 if curvature else 3)]
-        load_block, h_end = self.loading._eval_block, self.h_table_end
-        for s in range(0, n, _BLOCK):
+        memo = self._memo_of(hmn)
+        h_end = self.h_table_end
+        load_block = (self.loading if area else self._loading_without_area())._eval_block
+
+        def ob4(o):                               # p, k, a, dk (None without curvature)
+            return (o[0], o[1], o[2], o[3] if curvature else None)
+
+        for s in range(0, n, _BLOCK):             # blocks that stay in cache
             e = min(s + _BLOCK, n)
             hb, mb = h[s:e], hmn[s:e]
             ob = [o[s:e] for o in out]
-            load_block(np.minimum(hb, mb), ob[0], ob[1], ob[2], ob[3] if curvature else None)
-            un = np.flatnonzero((hb > mb) & (mb < h_end))
-            if un.size:
-                self._unload(hb.take(un), mb.take(un), ob, un, curvature)
-        return tuple(v.reshape(shape) for v in out)
+            unm = hb > mb
+            unm &= mb < h_end
+            un = np.flatnonzero(unm)
+            if not un.size:
+                load_block(hb, *ob4(ob))
+                continue
+            if memo.p0 is not None:
+                # h_min data remembered: the loading law only at the loading points
+                ld = np.flatnonzero(~unm)
+                if ld.size:
+                    tmp = [np.empty(ld.size) for _ in ob]
+                    load_block(hb.take(ld), *ob4(tmp))
+                    for o, t in zip(ob, tmp):
+                        o[ld] = t
+                ug = un + s
+                p0, a0 = memo.p0.take(ug), memo.a0.take(ug)
+                base, tm = memo.base.take(ug), memo.tm.take(ug)
+                kept = (memo, ug)
+            else:
+                # one loading evaluation per point: at h, or at h_min where unloading (p0, a0)
+                load_block(np.where(unm, mb, hb), *ob4(ob))
+                p0, a0 = ob[0].take(un), ob[2].take(un)
+                base, tm = self._row_cell(mb.take(un))
+                kept = None
+            self._unload(hb.take(un), mb.take(un), p0, a0, base, tm, ob, un, curvature, area,
+                         kept)
+        res = [v.reshape(shape) for v in out]
+        if not area:
+            res[2] = None
+        return tuple(res)
 
-    def _unload(self, h, hm, out, idx, curvature):
-        """The unloading branch at the points idx (h > h_min, h_min < h_table_end) of out,
-        whose loading values there are those at h_min (p0, a0)."""
+    def _loading_without_area(self) -> NormalLaw:
+        """The loading law that skips A/A0 (a = 0): the same p, k, dk/dh."""
+        law = self._memo.get("loading_without_area")
+        if law is None:
+            law = dataclasses.replace(self.loading, has_area=False)
+            self._memo["loading_without_area"] = law
+        return law
+
+    def _memo_of(self, hmn) -> "_HminMemo":
+        """The remembered h_min data of this h_min array: a new record (h_min only) if it is
+        not the array of the last call; at the second call with it, its data at every point
+        (from then on an unloading point skips the loading law at h_min and the row look-up)."""
+        memo = self._memo.get("h_min")
+        if memo is None or memo.h_min.shape != hmn.shape or not np.array_equal(memo.h_min, hmn):
+            memo = _HminMemo(hmn)
+            self._memo["h_min"] = memo
+        elif memo.p0 is None:
+            hm = np.minimum(memo.h_min, self.h_table_end)       # only h_min < h_end is used
+            p0, a0 = np.empty(hm.size), np.empty(hm.size)
+            for s in range(0, hm.size, _BLOCK):
+                e = min(s + _BLOCK, hm.size)
+                self.loading._eval_block(hm[s:e], p0[s:e], np.empty(e - s), a0[s:e], None)
+            memo.base, memo.tm = self._row_cell(hm)
+            memo.cell = np.full(hm.size, -1, dtype=np.intp)
+            memo.G = np.empty((2, 4, hm.size))
+            memo.p0, memo.a0 = p0, a0
+        return memo
+
+    def _row_cell(self, hm):
+        """First cell index (row cell i times the x cells) and local row coordinate tm of h_min."""
+        um = _row_v(hm, self._hm0, self._span, self._beta)
+        um *= self._n_m
+        i = np.minimum(um.astype(np.intp), self._n_m - 1)
+        um -= i
+        i *= self._xinv.size
+        return i, um
+
+    def _unload(self, h, hm, p0, a0, base, tm, out, idx, curvature, area=True, kept=None):
+        """The unloading branch at the points idx (h > h_min, h_min < h_table_end) of out;
+        p0, a0: the loading law at h_min; base, tm: ``_row_cell(h_min)``; ``area=False``:
+        out[2] is left as it is (rho's cells only); kept = (memo, point indices): the
+        points' polynomials in tx are taken from the memo where the point is in the same
+        cell as at its last evaluation (the same values: the same cell and tm), else made
+        and kept there."""
         sig = self.sigma
         x = h - hm
         x *= 1.0 / sig
         xc = np.minimum(x, self._X)
-        c, j, tm, tx = self._cell(hm, xc)
-        r = _poly(self._CF.take(c, axis=1), tm, tx, second=curvature)
+        j = self._lut.take((xc * self._lut_inv).astype(np.intp))
+        j += xc >= self._xnext.take(j)
+        tx = xc - self._xk.take(j)
+        tx *= self._xinv.take(j)
+        c = base + j
+        if kept is None:
+            g = _tm_horner((self._CF if area else self._CF[:16]).take(c, axis=1), tm)
+        else:
+            memo, ug = kept
+            miss = np.flatnonzero(memo.cell.take(ug) != c)
+            if miss.size:
+                um, cm = ug.take(miss), c.take(miss)
+                memo.G[:, :, um] = _tm_horner(self._CF.take(cm, axis=1), tm.take(miss))
+                memo.cell[um] = cm
+            g = memo.G.take(ug, axis=2) if area else memo.G[0].take(ug, axis=1)[None]
+        r = _tx_horner(g, tx, second=curvature)
         p = np.exp(r[0])
-        p *= out[0].take(idx)
+        p *= p0
+        s = self._xinv_h.take(j)
         d1 = r[1]
-        d1 *= self._xinv_h.take(j)                # d rho/dh = d rho/dtx dtx/dh
+        d1 *= s                                   # d rho/dh = d rho/dtx dtx/dh
         k = p * d1
         np.negative(k, out=k)
-        a = np.exp(r[2])
-        a *= out[2].take(idx)
+        if area:
+            a = np.exp(r[2])
+            a *= a0
+        else:
+            a = np.zeros(h.size)
         if curvature:
-            s = self._xinv_h.take(j)
-            dk = -p * (r[3] * s * s + d1 * d1)
+            dk = r[3] * s
+            dk *= s
+            dk += d1 * d1
+            dk *= p
+            np.negative(dk, out=dk)
         if x.max() > self._X:
             tp = np.flatnonzero(x > self._X)
             pe, ke, ae = p[tp], k[tp], a[tp]
@@ -655,7 +857,9 @@ class HistoryNormalLaw:
                 p[up], k[up], a[up] = lp[up], lk[up], la[up]
                 if curvature:
                     dk[up] = ld[up]
-        out[0][idx], out[1][idx], out[2][idx] = p, k, a
+        out[0][idx], out[1][idx] = p, k
+        if area:
+            out[2][idx] = a
         if curvature:
             out[3][idx] = dk
 
@@ -711,6 +915,19 @@ class HistoryNormalLaw:
             p0 = self.loading.evaluate(hb)[0]
             out[below] = np.maximum(W - self.sigma * p0 * self._IL, 0.0)
         return out.reshape(hm.shape)
+
+
+class _HminMemo:
+    """What the unloading points of one h_min array need of h_min alone: p_load(h_min), A0,
+    first cell index and row coordinate (``HistoryNormalLaw._row_cell``); None until filled."""
+
+    __slots__ = ("h_min", "p0", "a0", "base", "tm", "cell", "G")
+
+    def __init__(self, h_min):
+        self.h_min = h_min.copy()
+        self.p0 = self.a0 = self.base = self.tm = None
+        self.cell = None    # (n,) the cell whose polynomials in tx G holds (-1: none)
+        self.G = None       # (2, 4, n) rho's and ln(a/a0)'s polynomials in tx of that cell
 
 
 class UnloadingAboveLoadingWarning(UserWarning):

@@ -206,12 +206,16 @@ _SCAN_T = 6           # height nodes per half-panel of the scan
 _LOG_CUT = 34.0       # windows keep the integrand above exp(-34) of its maximum
 
 
-def _invert_delta_e(tau, tc, tp, kappa, f1, f2, f3, wc, wp, mat, smu, n_iter=20):
+def _invert_delta_e(tau, tc, tp, kappa, f1, f2, f3, wc, wp, mat, smu, n_iter=40):
     """Smallest t2 >= tc with delta_e(smu t2) >= smu tau on the ZMC/plastic branch (t units).
 
     delta_e is increasing on [omega_c, inf) (checked in the tests); plastic branch in closed
-    form (delta_e = C sqrt(W)), the ZMC branch by bisection (only where it is needed), ended by
-    a linear interpolation in the last bracket.
+    form (delta_e = C sqrt(W)), the ZMC branch (only where it is needed) by Newton's method
+    with the exact derivative of delta_e = 1.5 pa sqrt(A)/c_S, kept inside a shrinking
+    bracket (a step leaving it is replaced by the bisection), from the secant of the
+    bracket; at most n_iter steps, stopped when every step is below 1e-10 of t (quadratic
+    convergence: t is then at round-off; 4-5 steps). Steps below ~1e-11 cannot be asked for:
+    f has round-off noise of ~1e-11 of the target (the log of ZMC's mean pressure).
     """
     Es = mat.E_star
     # plastic: delta_e = 1.5 ch H A/S(A) = C_p sqrt(W)
@@ -231,18 +235,28 @@ def _invert_delta_e(tau, tc, tp, kappa, f1, f2, f3, wc, wp, mat, smu, n_iter=20)
         lo_, hi_ = Z(tc).copy(), Z(tp).copy()
         target = smu * ta
         flo, fhi = Z(dec) - target, Z(dep) - target          # < 0 and > 0
-        for _ in range(n_iter):
-            mid = 0.5 * (lo_ + hi_)
-            A, _ = zmc_area(smu * mid, ka, g1, g3, c, p_)      # ZMC branch only
-            P = A * zmc_mean_pressure(smu * mid, c, mat)[0]
-            f = _delta_e(smu * mid, A, P, g1, g2, Es) - target
+        cS = 2.0 * Es * (g2 / np.sqrt(g1)) / math.sqrt(math.pi)        # S(A) = cS sqrt(A)
+        t = lo_ - flo * (hi_ - lo_) / (fhi - flo)
+        act = np.arange(t.size)          # not converged yet (each point on its own: the
+        for _ in range(n_iter):          # result does not depend on the other points)
+            ti, lo_i, hi_i = t[act], lo_[act], hi_[act]
+            A, dA = zmc_area(smu * ti, ka[act], g1[act], g3[act], c[act], p_[act])
+            pa, dpa = zmc_mean_pressure(smu * ti, c[act], mat)      # ZMC branch only
+            sA = np.sqrt(A)
+            f = 1.5 * pa * sA / cS[act] - target[act]
+            df = 1.5 * smu / cS[act] * (dpa * sA + 0.5 * pa * dA / sA)   # d delta_e/dt
             up = f < 0
-            lo_, flo = np.where(up, mid, lo_), np.where(up, f, flo)
-            hi_, fhi = np.where(up, hi_, mid), np.where(up, fhi, f)
-        # linear interpolation in the last bracket (error ~ bracket^2)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            lin = lo_ - flo * (hi_ - lo_) / (fhi - flo)
-        hi[zmc] = np.where(np.isfinite(lin), np.clip(lin, lo_, hi_), hi_)
+            lo_i = np.where(up, ti, lo_i)
+            hi_i = np.where(up, hi_i, ti)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                tn = ti - f / df
+            out = ~((tn >= lo_i) & (tn <= hi_i))               # also NaN
+            tn[out] = 0.5 * (lo_i[out] + hi_i[out])
+            t[act], lo_[act], hi_[act] = tn, lo_i, hi_i
+            act = act[np.abs(tn - ti) > 1e-10 * ti]
+            if not act.size:
+                break
+        hi[zmc] = t
     return np.where(smu * tau <= dec, tc, np.where(smu * tau >= dep, np.maximum(tpl, tp), hi))
 
 
@@ -322,41 +336,67 @@ def _node_integrals(C, l, tau, K, zeta, n_t):
         vpk = np.clip(np.sqrt(np.maximum(-dl - T0, 0.0)), 0.0, vb)
         acc = [np.zeros(live.size) for _ in range(4)]
         cA = np.pi / ka
+        # per-node constants of the regime's (A, P, delta_e) (asperity.zmc_area,
+        # zmc_mean_pressure and the plastic law, written out: the height loop is the hot path)
         if regime == 0:
             cP = 4.0 / 3.0 * Es * g2 / np.sqrt(ka)
-        else:   # S(A) = cS sqrt(A)
-            cS = 2.0 * Es * (g2 / np.sqrt(g1)) / math.sqrt(math.pi)
+            cAe = g1 * cA
+        else:   # delta_e = 1.5 P/S(A), S(A) = cS sqrt(A)
+            rcS = 1.5 / (2.0 * Es * (g2 / np.sqrt(g1)) / math.sqrt(math.pi))
+        if regime == 1:
+            # A = cA W (f1 + (2 f3 - f1) S(y)), S = 3 y^2 - 2 y^3, y = (W - wc)/(wp - wc)
+            # in [0, 1]; pa = ch H - slope ln(R wc/W), W clipped to [wc, wp]
+            idw = 1.0 / (q - c)
+            d31 = 2.0 * g3 - g1
+            R = mat.omega_p_ratio
+            slope = mat.H * (mat.ch - 2.0 * mat.K_nu / 3.0) / math.log(R)
+            lRc = np.log(R * c)
+        elif regime == 2:
+            cAp = 2.0 * g3 * cA
+            chH = mat.ch * mat.H
         uta = smu * ta
         for lo, hi in ((0.0, vpk), (vpk, vb)):
+            span2 = 2.0 * (hi - lo)
             for j in range(n_t):
                 v = lo + (hi - lo) * x[j]
                 t = T0 + v * v
-                jac = 2.0 * v * (hi - lo) * w[j]
+                jac = v * span2 * w[j]
                 W = smu * t
                 if regime == 0:
-                    A, P = g1 * cA * W, cP * W * np.sqrt(W)
+                    A = cAe * W
+                    P = cP * W * np.sqrt(W)
                     de = np.maximum(W, 1e-300)        # W = 0 only at a node of weight 0
-                elif regime == 1:
-                    A, _ = zmc_area(W, ka, g1, g3, c, q)
-                    P = A * zmc_mean_pressure(np.clip(W, c, q), c, mat)[0]
-                    de = np.minimum(1.5 * P / (cS * np.sqrt(A)), W)
                 else:
-                    A = 2.0 * g3 * cA * W
-                    P = mat.ch * mat.H * A
-                    de = np.minimum(1.5 * P / (cS * np.sqrt(A)), W)
+                    if regime == 1:
+                        y = (W - c) * idw
+                        np.clip(y, 0.0, 1.0, out=y)
+                        A = cA * W * (g1 + d31 * (y * y * (3.0 - 2.0 * y)))
+                        P = A * (slope * (np.log(np.clip(W, c, q)) - lRc) + mat.ch * mat.H)
+                    else:
+                        A = cAp * W
+                        P = chH * A
+                    de = rcS * P / np.sqrt(A)
+                    np.minimum(de, W, out=de)
                 ide = 1.0 / de
-                xi = 1.0 - uta * ide                  # in (0, 1] inside the panel
+                xi = uta * ide                        # 1 - xi in (0, 1] inside the panel
+                np.subtract(1.0, xi, out=xi)
                 np.maximum(xi, 0.0, out=xi)
-                ide = np.where(xi > 0, ide, 0.0)
+                ide[xi <= 0] = 0.0
                 sx = np.sqrt(xi)
                 tt = t + dl
-                g = jac * np.exp(pr - 0.5 * tt * tt)
-                gP = g * P
+                tt *= tt
+                tt *= -0.5
+                tt += pr
+                g = np.exp(tt, out=tt)
+                g *= jac
                 gA = g * A
-                acc[0] += gP * xi * sx
-                acc[1] += 1.5 * gP * sx * ide
+                g *= P                                # g P
+                sx *= g                               # g P sqrt(xi)
+                acc[0] += sx * xi
+                acc[1] += sx * ide
                 acc[2] += gA * xi
                 acc[3] += gA * ide
+        acc[1] *= 1.5
         for o, a in zip(out, acc):
             o[live] += a
     return [o.reshape(shape) for o in out]

@@ -14,6 +14,8 @@ are exercised by the coarse real table at the end. Units: mm, MPa.
 """
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 from scipy.integrate import trapezoid
 import pytest
@@ -168,16 +170,22 @@ def test_bad_build_arguments_are_named():
             HistoryNormalLaw.elasto_plastic(s, mat, **{"rtol": 1e-3, **kw})
 
 
+@functools.lru_cache(maxsize=None)
+def _coarse_loading():
+    """Table 1 surface, psi = 1, and its coarse loading law (rtol 1e-2, n_quad 8)."""
+    from rough_contact.micro.asperity import AsperityMaterial
+    from rough_contact.surface import SpectralMoments
+    s = SpectralMoments(m00=0.0625, m20=8e-5, m02=8e-4, m40=1.04e-6, m04=1.04e-4)
+    mat = AsperityMaterial(E_star=1.14e5, psi=1.0).resolve(s)
+    return s, mat, NormalLaw.elasto_plastic(s, mat, rtol=1e-2, n_quad=8)
+
+
 def test_coarse_population_table_against_direct_sums_at_random_points():
     """A coarse table of the paper's Table 1 surface (rtol 1e-2, cheap sums n_quad 8): its
     error against the direct sums at random points -- not the build's own check points -- is
     within rtol, k >= 0 on the build's dense sample, and the build's bookkeeping is sane."""
     from rough_contact.micro import unloading as U
-    from rough_contact.micro.asperity import AsperityMaterial
-    from rough_contact.surface import SpectralMoments
-    s = SpectralMoments(m00=0.0625, m20=8e-5, m02=8e-4, m40=1.04e-6, m04=1.04e-4)
-    mat = AsperityMaterial(E_star=1.14e5, psi=1.0).resolve(s)
-    loading = NormalLaw.elasto_plastic(s, mat, rtol=1e-2, n_quad=8)
+    s, mat, loading = _coarse_loading()
     rtol = 1e-2
     law = HistoryNormalLaw.elasto_plastic(s, mat, rtol, loading=loading, n_quad=8, n_t=16,
                                           n_zeta=8, n_rows=3, n_x=2)
@@ -264,3 +272,105 @@ def test_unloading_above_loading_is_capped_by_the_loading_branch():
     u = np.array([0.25, 0.5, 1.0]) * SIG
     r_load = -u / LAM
     assert H._count_above_loading(r_load + [0.3, -0.2, 0.5e-4], law.loading, 1e-3, u, 1e-4) == 1
+
+
+def test_h_min_beyond_the_table_end_gives_the_loading_law_at_h():
+    """h_min >= h_table_end: nothing has yielded, the loading law at h (reversible). The law
+    returned the loading law at h_min there (p frozen at p_load(h_min) while k = k_load(h_min)
+    > 0: a tangent that is not the derivative of p)."""
+    law = _synthetic(_rho, _drho, _la, _dla)
+    L = law.loading
+    hm = np.linspace(L.h_table_end, L.h_max, 41)[:-1]
+    h = hm + 0.3 * (L.h_max - hm)
+    for got, want in zip(law.evaluate_history(h, hm, curvature=True), L.evaluate(h, True)):
+        np.testing.assert_array_equal(got, want)
+    d = 1e-4 * (L.h_max - L.h_table_end)
+    k_fd = (law.evaluate_history(h - d, hm)[0] - law.evaluate_history(h + d, hm)[0]) / (2 * d)
+    np.testing.assert_allclose(law.evaluate_history(h, hm)[1], k_fd, rtol=1e-4)
+
+
+def _mixed_points(law, n, seed):
+    """Loading, unloading, taper, below-table, beyond-the-table-end and virgin points."""
+    rng = np.random.default_rng(seed)
+    lo, hi = law.h_min - 0.2 * law._span, law.h_max
+    hm = rng.uniform(lo, hi, n)
+    hm[::9] = np.inf
+    h = hm + rng.uniform(-0.5, 1.5, n) * XK[-1] * SIG
+    h[::9] = rng.uniform(lo, hi, h[::9].size)
+    return h, hm
+
+
+@pytest.mark.parametrize("curvature", [False, True])
+def test_repeated_h_min_is_remembered_bit_for_bit(curvature):
+    """A Newton loop calls with the same committed h_min every iteration: from the second
+    call on, what unloading points need of h_min alone is remembered, and a point's cell
+    polynomial in x while it stays in its x cell. Every call must give
+    exactly what a law that never saw this h_min gives (a fresh copy), for changing h, with
+    and without A/A0, over several evaluation blocks; and an h_min array changed in place
+    must not be mistaken for the remembered one."""
+    import pickle
+    law = _synthetic(_rho, _drho, _la, _dla)
+    n = 2 * H._BLOCK + 777
+    h, hm = _mixed_points(law, n, 7)
+    rng = np.random.default_rng(8)
+    kept = []
+    for it, area in enumerate([False, False, True, True, False, True, True]):
+        hh = h + rng.normal(0.0, 0.05, n) * SIG * (it > 0)
+        memo = law._memo.get("h_min")
+        before = None if memo is None or memo.cell is None else memo.cell.copy()
+        got = law.evaluate_history(hh, hm, curvature, area=area)
+        if before is not None:          # points whose x cell was kept, and points that moved
+            after = law._memo["h_min"].cell
+            kept.append((np.count_nonzero((after == before) & (before >= 0)),
+                          np.count_nonzero((after != before) & (before >= 0))))
+        fresh = pickle.loads(pickle.dumps(law)).evaluate_history(hh, hm, curvature, area=area)
+        assert (got[2] is None) == (not area) and (fresh[2] is None) == (not area)
+        for x, y in zip(got, fresh):
+            if y is not None:
+                np.testing.assert_array_equal(x, y)
+    assert law._memo["h_min"].p0 is not None           # the hot path was taken
+    assert all(k > n / 6 and c > 0 for k, c in kept[1:])   # cells kept and cells changed
+    # what is remembered is not part of the law's identity (checkpoint fingerprints)
+    from rough_contact.fingerprint import describe
+    assert describe(law) == describe(_synthetic(_rho, _drho, _la, _dla))
+    hm[::3] -= 0.3 * SIG                               # changed in place: not the same h_min
+    got = law.evaluate_history(h, hm, curvature)
+    fresh = pickle.loads(pickle.dumps(law)).evaluate_history(h, hm, curvature)
+    for x, y in zip(got, fresh):
+        np.testing.assert_array_equal(x, y)
+
+
+def test_without_area_same_p_k_dk():
+    law = _synthetic(_rho, _drho, _la, _dla)
+    h, hm = _mixed_points(law, 5000, 9)
+    full = law.evaluate_history(h, hm, curvature=True)
+    part = law.evaluate_history(h, hm, curvature=True, area=False)
+    assert part[2] is None
+    for i in (0, 1, 3):
+        np.testing.assert_array_equal(part[i], full[i])
+    rev = HistoryNormalLaw(loading=law.loading, rtol=1e-3)      # reversible: h_min ignored
+    p, k, a = rev.evaluate_history(h, hm, area=False)
+    assert a is None
+    np.testing.assert_array_equal(p, law.loading.evaluate(h)[0])
+
+
+def test_budget_exhausted_on_a_coarse_level_returns_that_table_or_raises():
+    """The coarse row levels of the build have no ghost rows (not-a-knot at the table's
+    ends): with strict=False a budget that runs out there returns that table -- a usable law
+    (finite, k >= 0, the branch starting on the loading law) flagged as not converged;
+    strict=True raises and names the budget."""
+    s, mat, loading = _coarse_loading()
+    kw = dict(loading=loading, n_quad=8, n_t=16, n_zeta=8, n_rows=3, n_x=2)
+    law = HistoryNormalLaw.elasto_plastic(s, mat, 1e-3, strict=False, max_points=150, **kw)
+    info = law.info
+    assert not info["converged"] and info["levels"][-1][-1] == "interior"
+    assert info["worst_error_h_min"] > 0.5e-3 and info["k_nonnegative"]
+    rng = np.random.default_rng(2)
+    hm = rng.uniform(loading.h_min, loading.h_table_end, 4000)
+    h = hm + rng.uniform(0.0, 8.0, 4000) * s.rq
+    p, k, a, dk = law.evaluate_history(h, hm, curvature=True)
+    assert all(np.all(np.isfinite(v)) for v in (p, k, a, dk)) and np.all(k >= 0)
+    np.testing.assert_allclose(law.evaluate_history(hm + 1e-9 * s.rq, hm)[0],
+                               loading.evaluate(hm)[0], rtol=1e-6)
+    with pytest.raises(RuntimeError, match="max_points = 60"):
+        HistoryNormalLaw.elasto_plastic(s, mat, 1e-3, strict=True, max_points=60, **kw)

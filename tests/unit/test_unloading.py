@@ -227,3 +227,31 @@ def test_direct_sums_high_above_the_mean_plane_need_24_zeta_nodes(psi):
     assert abs(a[0, 0] / load.pressure[0] - 1) < 1e-5
     old = np.array(U._row_sums(S1, mat, hm, u, 16, 16)[:3])      # n_zeta = n_quad = 16
     assert np.max(np.abs(old / ref - 1)) > 1e-4
+
+
+@pytest.mark.parametrize("e1", [1.0, 0.3, 0.05])
+def test_delta_e_inversion_recovers_omega_max(e1):
+    """The panel start t2 of the unloading sums: the largest interference whose recovered
+    interference delta_e equals u, found by ``_invert_delta_e`` (safeguarded Newton) to round-off; checked
+    against ``recovered_interference`` (the summit's own loading law and delta_e) at omega_max
+    across the elasto-plastic range and beyond it (plastic, closed form)."""
+    kappa, f1, f2, f3, wc, wp = U._resolve(KAPPA, e1, MAT, "exact")
+    W = np.concatenate([np.geomspace(1.0 + 1e-6, float(wp / wc) * (1 - 1e-9), 300),
+                        np.geomspace(float(wp / wc) * 1.001, 1e3, 30)]) * wc
+    _, de = U.recovered_interference(W, KAPPA, e1, MAT)
+    smu = 1e-3                                      # any length scale: t = omega/smu
+    t2 = U._invert_delta_e(de / smu, wc / smu, wp / smu, kappa, f1, f2, f3, wc, wp, MAT, smu)
+    np.testing.assert_allclose(t2 * smu, W, rtol=1e-12)      # (bisection + secant: 5.5e-11)
+
+
+def test_direct_sums_of_a_point_do_not_depend_on_the_other_points():
+    """The history table computes a row's points in several calls (and its u = 0 point once):
+    the sums at one point must be bit for bit the same whatever else is in the call (the
+    Newton inversion of delta_e stops per point, not when the whole batch has converged)."""
+    mat = AsperityMaterial(E_star=E_STAR, psi=1.0).resolve(S1)
+    sig = S1.rq
+    u = np.array([0.0, 0.05, 0.4, 1.0, 2.5, 5.0]) * sig
+    together = np.array(U._row_sums(S1, mat, 0.3 * sig, u, 16, 16, 24))
+    alone = np.array([np.array(U._row_sums(S1, mat, 0.3 * sig, u[i:i + 1], 16, 16, 24))[:, 0]
+                      for i in range(u.size)]).T
+    np.testing.assert_array_equal(together, alone)
