@@ -10,7 +10,7 @@ increment, CPU time and the dissipation at the peak and at the end.
 
     OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bench_coulomb_punch.py \\
         [--levels 1 2 3] [--mu 0.2 0.5] [--k 1e7] [--predictor none secant]
-        [--quadrature gauss vertex nodal] [--reversal-stiffness 0 1] [--augmented 0 1] [--al-tol 1e-3]
+        [--quadrature gauss vertex nodal] [--reversal-stiffness 0 1] [--augmented 0 1 2] [--al-tol 1e-3]
         [--continuation none 100,10] [--after 10] [--linear-solver auto mumps hypre] [--csv FILE]
 
 Levels (P1; mesh and contact size in LEVELS): 1 ~4.5 k DOFs, 2 ~26 k, 3 ~73 k, 4 ~99 k (the size
@@ -33,7 +33,9 @@ import numpy as np  # noqa: E402
 from mpi4py import MPI  # noqa: E402
 from petsc4py import PETSc  # noqa: E402
 
-from rough_contact.interface.enforcement import AugmentedLagrangian, Penalty
+from rough_contact.fem.nodal import NodalContactInterface
+from rough_contact.interface.enforcement import (AugmentedLagrangian, NewtonAugmentedLagrangian,
+                                                 Penalty)
 from rough_contact.interface.penalty import SoftplusPenalty
 from rough_contact.scenes import flat_punch
 from rough_contact.solver.loading import LoadStepError, load_path, load_unload_factors
@@ -46,11 +48,16 @@ N_LOAD = 16
 
 def run(level: int, mu: float, k: float, width: float, predictor: str, quadrature="gauss",
         comm=MPI.COMM_WORLD, verbose=False, reversal_stiffness=1.0, augmented=False,
-        al_tol=1e-3, continuation=None, linear_solver="auto") -> dict:
+        al_tol=1e-3, continuation=None, linear_solver="auto", residual_ratio=1e-2) -> dict:
     mesh_size, contact_size = LEVELS[level]
     law = SoftplusPenalty(k_normal=k, width=width, k_tangential=k, friction=mu,
                           reversal_stiffness=reversal_stiffness)
-    enforcement = AugmentedLagrangian(tolerance=al_tol) if augmented else Penalty()
+    if augmented == 2:     # multipliers updated inside the Newton iteration (nodal points)
+        enforcement = NewtonAugmentedLagrangian(tolerance=al_tol, residual_ratio=residual_ratio)
+    elif augmented:
+        enforcement = AugmentedLagrangian(tolerance=al_tol)
+    else:
+        enforcement = Penalty()
     m = flat_punch.build(comm, mesh_size=mesh_size, contact_size=contact_size, order=1,
                          load_half_width=10.0, law=law, steps=N_LOAD,
                          quadrature="gauss" if quadrature == "nodal" else quadrature,
@@ -80,6 +87,8 @@ def run(level: int, mu: float, k: float, width: float, predictor: str, quadratur
                              + ("" if cont.after is None else f"/{cont.after}")),
                linear_solver=m.solver.option_set,
                al_updates=sum(i.augmentations for i in incs),
+               newton_updates=(m.interface.newton_updates
+                               if isinstance(m.interface, NodalContactInterface) else 0),
                newton=sum(i.newton_total for i in incs),
                solves=len(incs) + sum(i.failed_attempts for i in incs),
                cutbacks=sum(i.cutbacks for i in incs),
@@ -105,10 +114,14 @@ def main(argv=None):
                     "nodal point set through the Gauss rule (rough_contact.fem.nodal)")
     ap.add_argument("--reversal-stiffness", type=float, nargs="+", default=[1.0],
                     help="SoftplusPenalty.reversal_stiffness (0 = consistent tangent everywhere)")
-    ap.add_argument("--augmented", type=int, nargs="+", default=[0], choices=[0, 1],
-                    help="1 = augmented Lagrangian (Uzawa) on top of the penalty")
+    ap.add_argument("--augmented", type=int, nargs="+", default=[0], choices=[0, 1, 2],
+                    help="1 = augmented Lagrangian (Uzawa) on top of the penalty; 2 = the "
+                    "multipliers updated inside the Newton iteration (NewtonAugmentedLagrangian, "
+                    "--quadrature nodal only)")
     ap.add_argument("--al-tol", type=float, default=1e-3,
                     help="AugmentedLagrangian.tolerance")
+    ap.add_argument("--residual-ratio", type=float, default=1e-2,
+                    help="NewtonAugmentedLagrangian.residual_ratio (--augmented 2)")
     ap.add_argument("--continuation", nargs="+", default=["100,10"],
                     help="penalty continuation: softening factors (default 100,10, the "
                          "solver's) or none (rough_contact.solver.snes.Continuation)")
@@ -123,7 +136,7 @@ def main(argv=None):
     args, _petsc = ap.parse_known_args(argv)   # the rest goes to PETSc
     rows = []
     head = (f"{'level':>5} {'DOFs':>7} {'points':>6} {'mu':>4} {'k':>7} {'rev':>4} "
-            f"{'predictor':>9} {'AL':>2} {'upd':>4} {'cont':>10} {'linear':>6} "
+            f"{'predictor':>9} {'AL':>2} {'upd':>4} {'Nupd':>5} {'cont':>10} {'linear':>6} "
             f"{'Newton':>6} {'solves':>6} {'cutb':>4} {'max/inc':>7} {'CPU s':>7} "
             f"{'D peak':>10} {'D end':>10} {'slip':>5}")
     PETSc.Sys.Print(head)
@@ -138,13 +151,17 @@ def main(argv=None):
                     cont = (None if co == "none" else Continuation(
                         tuple(float(x) for x in co.split(",")),
                         None if args.after == "none" else int(args.after)))
+                    if al == 2 and quad != "nodal":
+                        continue       # the in-Newton update is the nodal point set's
                     r = run(level, mu, k, w, pred, quad, verbose=args.verbose,
-                            reversal_stiffness=rs, augmented=bool(al), al_tol=args.al_tol,
-                            continuation=cont, linear_solver=ls)
+                            reversal_stiffness=rs, augmented=al, al_tol=args.al_tol,
+                            continuation=cont, linear_solver=ls,
+                            residual_ratio=args.residual_ratio)
                     rows.append(r)
                     PETSc.Sys.Print(
                         f"{r['level']:5d} {r['dofs']:7d} {r['points']:6d} {mu:4.2f} {k:7.1e} "
                         f"{rs:4.2g} {pred + '/' + quad[0]:>9} {al:2d} {r['al_updates']:4d} "
+                        f"{r['newton_updates']:5d} "
                         f"{r['continuation']:>10} {r['linear_solver']:>6} "
                         f"{r['newton']:6d} "
                         f"{r['solves']:6d} {r['cutbacks']:4d} "

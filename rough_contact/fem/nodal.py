@@ -48,6 +48,7 @@ from rough_contact.fem.contact import ContactInterface
 from rough_contact.fem.jump import JumpOperator
 from rough_contact.fem.pairing.base import PairedPoints, SurfaceContext, local_frames
 from rough_contact.fem.pairing.facets import basix_cell
+from rough_contact.interface.enforcement import NewtonAugmentedLagrangian
 
 __all__ = ["NodalContactInterface", "NodalPoints", "VertexJumpOperator", "nodal_points",
            "vertex_shape_matrix"]
@@ -288,6 +289,7 @@ class NodalContactInterface(ContactInterface):
             raise ValueError(f"sliding = {sliding!r} is invalid for the nodal point set: only "
                              "'small' (the vertex rows are built once at set-up)")
         super().__init__(V, facet_tags, first_tag, second_tag, **kwargs)
+        self.newton_updates = 0      # multiplier updates inside Newton iterations (all solves)
 
     def _point_set(self, ctx: SurfaceContext, bcs: Sequence) -> JumpOperator:
         quad = JumpOperator(ctx.V, self.paired, bcs=bcs)
@@ -300,6 +302,39 @@ class NodalContactInterface(ContactInterface):
             frames=nodal.frames, jump0=nodal.jump0, N1=np.zeros((n_v, 1, 0)),
             nodes1=nodal.vertex[:, None], partners=None, name="nodal")
         return VertexJumpOperator(ctx.V, nodal, bcs=bcs)
+
+    def updates_in_newton(self) -> bool:
+        """Whether the enforcement updates the multipliers inside the Newton iteration
+        (``NewtonAugmentedLagrangian``; the solver's ``NewtonIterationHook``)."""
+        return isinstance(self.enforcement, NewtonAugmentedLagrangian)
+
+    def newton_iteration(self, iteration: int, residual: float, first: float) -> bool:
+        """The Newton solver's per-iteration hook (``rough_contact.solver.snes.
+        NewtonIterationHook``; collective): with ``NewtonAugmentedLagrangian``, from Newton
+        iteration ``first_iteration`` on, lambda <- the tractions of the last evaluation (the
+        current iterate: the solver evaluates the residual at an iterate before starting the
+        iteration from it) if that moves the multipliers by more than the tolerance (largest
+        change over all vertices and ranks / largest traction magnitude). Not during a
+        penalty continuation's softened solves. Returns whether the multipliers changed (the
+        residual must be evaluated again); counts the updates in ``newton_updates``."""
+        enf = self.enforcement
+        if (not isinstance(enf, NewtonAugmentedLagrangian) or self._softened is not None
+                or iteration < enf.first_iteration or self._last is None
+                or residual > enf.residual_ratio * first):
+            return False
+        res = self._last
+        update = enf.update(self.history.multipliers, res)
+        top = np.zeros(2)
+        if update.change.size:
+            top[:] = update.change.max(), np.linalg.norm(res.traction, axis=1).max()
+        self.comm.Allreduce(MPI.IN_PLACE, top, op=MPI.MAX)
+        rel = top[0] / top[1] if top[1] > 0.0 else 0.0
+        if rel <= enf.tolerance:
+            return False
+        self.history.set_multipliers(update.multipliers)
+        self._forget()
+        self.newton_updates += 1
+        return True
 
     def describe(self) -> dict:
         """``ContactInterface.describe`` plus the point set (a checkpoint of the quadrature

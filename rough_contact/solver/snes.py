@@ -39,7 +39,7 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass, field
-from typing import Mapping, Optional, Union
+from typing import Mapping, Optional, Protocol, Union, runtime_checkable
 
 import numpy as np
 from petsc4py import PETSc
@@ -50,6 +50,7 @@ from rough_contact.solver.options import default_options, set_default_options, u
 from rough_contact.validation import check_scalar
 
 __all__ = ["SolveResult", "SNESSolver", "UnusedOptionsWarning", "set_default_options",
+           "NewtonIterationHook",
            "LINEAR_SOLVERS", "AMG_DEFAULT", "DEFAULT_DOF_THRESHOLD", "Continuation"]
 
 
@@ -163,6 +164,26 @@ def _parse_continuation(text: str) -> Optional[Continuation]:
         raise ValueError(f"continuation = {text!r} is invalid: give 'none' or comma-separated "
                          "softening factors > 1, decreasing (e.g. 100,10)") from None
     return Continuation(factors)
+
+
+@runtime_checkable
+class NewtonIterationHook(Protocol):
+    """An interface that may change its law between Newton iterations (e.g. multipliers
+    updated inside the Newton iteration, ``rough_contact.interface.enforcement.
+    NewtonAugmentedLagrangian``). :class:`SNESSolver` calls :meth:`newton_iteration` in its
+    convergence test, after the residual at Newton iterate ``iteration`` was evaluated; if it
+    returns True, the residual is evaluated again at the same iterate with the changed law and
+    the solve does not stop there."""
+
+    def updates_in_newton(self) -> bool:
+        """Whether :meth:`newton_iteration` may change the law (else the solver ignores the
+        hook: its Newton iteration is PETSc's own)."""
+        ...
+
+    def newton_iteration(self, iteration: int, residual: float, first: float) -> bool:
+        """At Newton iterate ``iteration`` with residual norm ``residual`` [N], ``first`` that
+        of the solve's start (collective): True if the law changed."""
+        ...
 
 
 class UnusedOptionsWarning(UserWarning):
@@ -312,6 +333,13 @@ class SNESSolver:
             "snes_error_if_not_converged": False,
         }
         opts.update(LINEAR_SOLVERS[linear_solver])
+        hook = (isinstance(problem.interface, NewtonIterationHook)
+                and problem.interface.updates_in_newton())
+        if hook:
+            # a law changed between iterations (_converged_with_hook) changes the residual the
+            # next step starts from; PETSc 3.18's backtracking compares the step with the norm
+            # before the change and fails: full Newton steps
+            opts["snes_linesearch_type"] = "basic"
         opts.update(defaults or {})
         self.defaults = opts  # without prefix; in the database only inside _options()
         # An absolute tolerance given by the user (command line or ``defaults``) is kept as is;
@@ -340,6 +368,39 @@ class SNESSolver:
         self._tighten = None
         self._reported_after_first_solve = False
         self.snes.setMonitor(self._monitor)
+        if hook:
+            self._ttol = self._fnorm0 = 0.0
+            self.snes.setConvergenceTest(self._converged_with_hook)
+
+    def _converged_with_hook(self, snes, iteration, norms):
+        """PETSc's default convergence test (absolute, relative to the first residual, step
+        length) for an interface with a :class:`NewtonIterationHook`: the iterate is not
+        converged if the interface changed its law there; the residual is then evaluated again
+        with the changed law (the next Newton step solves with it)."""
+        xnorm, ynorm, fnorm = (float(v) for v in norms)
+        rtol, atol, stol, _ = snes.getTolerances()
+        reasons = PETSc.SNES.ConvergedReason
+        if iteration == 0:
+            self._ttol, self._fnorm0 = fnorm * rtol, fnorm
+        if not np.isfinite(fnorm):
+            return reasons.DIVERGED_FNORM_NAN
+        try:
+            changed = self.problem.interface.newton_iteration(int(iteration), fnorm,
+                                                              self._fnorm0)
+            if changed:
+                self.problem.F(snes, snes.getSolution(), snes.getFunction()[0])
+        except Exception as exc:
+            self.problem.callback_error = exc
+            raise
+        if changed:
+            return reasons.ITERATING
+        if fnorm < atol:
+            return reasons.CONVERGED_FNORM_ABS
+        if iteration > 0 and fnorm <= self._ttol:
+            return reasons.CONVERGED_FNORM_RELATIVE
+        if iteration > 0 and ynorm < stol * xnorm:
+            return reasons.CONVERGED_SNORM_RELATIVE
+        return reasons.ITERATING
 
     def _set_near_nullspace(self, near_nullspace) -> None:
         """Rigid-body modes for the algebraic multigrid preconditioners (else none)."""
