@@ -338,7 +338,8 @@ class SNESSolver:
         if hook:
             # a law changed between iterations (_converged_with_hook) changes the residual the
             # next step starts from; PETSc 3.18's backtracking compares the step with the norm
-            # before the change and fails: full Newton steps
+            # before the change and fails: PETSc takes the full step, the convergence test
+            # backtracks with the current norms
             opts["snes_linesearch_type"] = "basic"
         opts.update(defaults or {})
         self.defaults = opts  # without prefix; in the database only inside _options()
@@ -369,31 +370,77 @@ class SNESSolver:
         self._reported_after_first_solve = False
         self.snes.setMonitor(self._monitor)
         if hook:
-            self._ttol = self._fnorm0 = 0.0
+            self._ttol = self._fnorm0 = self._f_prev = 0.0
+            self._x_prev = None
             self.snes.setConvergenceTest(self._converged_with_hook)
 
     def _converged_with_hook(self, snes, iteration, norms):
         """PETSc's default convergence test (absolute, relative to the first residual, step
-        length) for an interface with a :class:`NewtonIterationHook`: the iterate is not
-        converged if the interface changed its law there; the residual is then evaluated again
-        with the changed law (the next Newton step solves with it)."""
+        length) for an interface with a :class:`NewtonIterationHook`, with the line search
+        done here (PETSc's is ``basic``: a full step, evaluated): the residual norm at the
+        full step is compared with the one at the previous iterate as the interface's law then
+        was, and the step is halved until |F| <= (1 - 1e-4 theta) |F_previous| (at most
+        ``_MAX_BACKTRACKS`` times, else DIVERGED_LINE_SEARCH); the iterate and residual are
+        replaced in place. Then the interface may change its law (:meth:`NewtonIterationHook.
+        newton_iteration`): the residual is evaluated again at the same iterate and the solve
+        does not stop there. The monitor has already printed the full step's norm."""
         xnorm, ynorm, fnorm = (float(v) for v in norms)
         rtol, atol, stol, _ = snes.getTolerances()
         reasons = PETSc.SNES.ConvergedReason
-        if iteration == 0:
-            self._ttol, self._fnorm0 = fnorm * rtol, fnorm
-        if not np.isfinite(fnorm):
-            return reasons.DIVERGED_FNORM_NAN
+        x, f = snes.getSolution(), snes.getFunction()[0]
         try:
+            if iteration == 0:
+                self._ttol, self._fnorm0 = fnorm * rtol, fnorm
+                self._x_prev = x.copy()
+            elif np.isfinite(fnorm) and fnorm > self._f_prev:
+                fnorm = self._backtrack(snes, x, f, fnorm)
+            if not np.isfinite(fnorm):
+                return reasons.DIVERGED_FNORM_NAN
+            if iteration > 0 and fnorm > self._f_prev * (1.0 - 1e-12):   # no decrease
+                if fnorm < atol:
+                    return reasons.CONVERGED_FNORM_ABS
+                return (reasons.CONVERGED_FNORM_RELATIVE if fnorm <= self._ttol
+                        else reasons.DIVERGED_LINE_SEARCH)
             changed = self.problem.interface.newton_iteration(int(iteration), fnorm,
                                                               self._fnorm0)
             if changed:
-                self.problem.F(snes, snes.getSolution(), snes.getFunction()[0])
+                self.problem.F(snes, x, f)
+                fnorm = f.norm()
+            self._f_prev = fnorm
+            x.copy(self._x_prev)
         except Exception as exc:
             self.problem.callback_error = exc
             raise
         if changed:
             return reasons.ITERATING
+        if fnorm < atol:
+            return reasons.CONVERGED_FNORM_ABS
+        if iteration > 0 and fnorm <= self._ttol:
+            return reasons.CONVERGED_FNORM_RELATIVE
+        if iteration > 0 and ynorm < stol * xnorm:
+            return reasons.CONVERGED_SNORM_RELATIVE
+        return reasons.ITERATING
+
+    _MAX_BACKTRACKS = 12
+
+    def _backtrack(self, snes, x, f, fnorm: float) -> float:
+        """Armijo backtracking on |F| along the full step x - x_prev (in place); the norm
+        reached (its first value that decreases enough, or the last tried)."""
+        step = x.copy()
+        step.axpy(-1.0, self._x_prev)
+        theta = 1.0
+        try:
+            for _ in range(self._MAX_BACKTRACKS):
+                if np.isfinite(fnorm) and fnorm <= (1.0 - 1e-4 * theta) * self._f_prev:
+                    break
+                theta *= 0.5
+                self._x_prev.copy(x)
+                x.axpy(theta, step)
+                self.problem.F(snes, x, f)
+                fnorm = f.norm()
+        finally:
+            step.destroy()
+        return fnorm
         if fnorm < atol:
             return reasons.CONVERGED_FNORM_ABS
         if iteration > 0 and fnorm <= self._ttol:
