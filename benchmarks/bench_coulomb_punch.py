@@ -6,7 +6,9 @@ punch top (1000 N on the full punch), 16 loading increments and 16 unloading one
 of the load (a punch held only by a penalty contact has no equilibrium at zero load),
 isotropic Coulomb friction (``SoftplusPenalty``). Prints per run: DOFs, interface points,
 Newton iterations (all attempts, including failed ones), cutbacks, the largest count in one
-increment, CPU time and the dissipation at the peak and at the end.
+increment, CPU time, the dissipation at the peak and at the end, and at the peak the largest
+k_N |g| over the points in contact (kg/t) and k_T |s - s_p| over the sticking ones (kTs/t),
+relative to the largest traction (about 1 for a penalty, the tolerance for exact enforcement).
 
     OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bench_coulomb_punch.py \\
         [--levels 1 2 3] [--mu 0.2 0.5] [--k 1e7] [--predictor none secant]
@@ -67,12 +69,15 @@ def run(level: int, mu: float, k: float, width: float, predictor: str, quadratur
                                              linear_solver=linear_solver))
     factors = load_unload_factors(N_LOAD, N_LOAD - 1, final_factor=1.0 / N_LOAD)
     t0 = time.process_time()
+    exact = (float("nan"), float("nan"))
     incs = []
     kwargs = {"predictor": predictor}
     failed = ""
     try:
         for inc in load_path(m.problem, m.solver, factors, verbose=verbose, **kwargs):
             incs.append(inc)
+            if inc.load_factor == 1.0:
+                exact = _exactness(m.interface, law, comm)
     except LoadStepError as exc:     # reported as a row: the run did not complete
         failed = f"LoadStepError at load factor {exc.load_factor:.6g}"
         PETSc.Sys.Print(f"  FAILED: {exc}")
@@ -96,9 +101,26 @@ def run(level: int, mu: float, k: float, width: float, predictor: str, quadratur
                D_peak=peak.dissipation if peak else float("nan"),
                D_end=float("nan") if failed else incs[-1].dissipation,
                slip_peak=peak.n_slipping / max(peak.n_points, 1) if peak else float("nan"),
+               gap_peak=exact[0], stick_peak=exact[1],
                failed=failed)
     m.solver.destroy()
     return out
+
+
+def _exactness(interface, law, comm) -> tuple:
+    """At the current (converged) state: the largest k_N |g| over the points in contact and
+    the largest k_T |s - s_p| (the elastic slip) over the sticking ones, both relative to the
+    largest traction magnitude [-]. About 1 for a penalty (its compliance), about the
+    augmentation tolerance for exact enforcement."""
+    pf = interface.point_fields()
+    stick = pf.contact & ~pf.slipping
+    t = np.hypot(pf.pressure, np.linalg.norm(pf.shear, axis=1))
+    vals = np.array([np.max(law.k_normal * np.abs(pf.gap[pf.contact]), initial=0.0),
+                     np.max(law.k_tangential * np.linalg.norm(
+                         (pf.slip - pf.plastic_slip)[stick], axis=1), initial=0.0),
+                     np.max(t, initial=0.0)])
+    comm.Allreduce(MPI.IN_PLACE, vals, op=MPI.MAX)
+    return vals[0] / vals[2], vals[1] / vals[2]
 
 
 def main(argv=None):
@@ -138,7 +160,7 @@ def main(argv=None):
     head = (f"{'level':>5} {'DOFs':>7} {'points':>6} {'mu':>4} {'k':>7} {'rev':>4} "
             f"{'predictor':>9} {'AL':>2} {'upd':>4} {'Nupd':>5} {'cont':>10} {'linear':>6} "
             f"{'Newton':>6} {'solves':>6} {'cutb':>4} {'max/inc':>7} {'CPU s':>7} "
-            f"{'D peak':>10} {'D end':>10} {'slip':>5}")
+            f"{'D peak':>10} {'D end':>10} {'slip':>5} {'kg/t':>8} {'kTs/t':>8}")
     PETSc.Sys.Print(head)
     for level in args.levels:
         for mu in args.mu:
@@ -166,7 +188,8 @@ def main(argv=None):
                         f"{r['newton']:6d} "
                         f"{r['solves']:6d} {r['cutbacks']:4d} "
                         f"{r['max_its']:7d} {r['cpu']:7.1f} {r['D_peak']:10.4e} "
-                        f"{r['D_end']:10.4e} {r['slip_peak']:5.2f}"
+                        f"{r['D_end']:10.4e} {r['slip_peak']:5.2f} {r['gap_peak']:8.1e} "
+                        f"{r['stick_peak']:8.1e}"
                         + (f"  FAILED ({r['failed']})" if r["failed"] else ""))
     if args.csv and MPI.COMM_WORLD.rank == 0:
         write_csv(args.csv, rows)

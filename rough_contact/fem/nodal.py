@@ -332,7 +332,7 @@ class NodalContactInterface(ContactInterface):
         if rel <= enf.tolerance:
             return False
         self.history.set_multipliers(update.multipliers)
-        self._forget()
+        self._last = None      # the solver evaluates again; the Newton-step memo is kept
         self.newton_updates += 1
         return True
 
