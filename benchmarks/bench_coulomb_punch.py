@@ -23,6 +23,7 @@ Units: mm, N, MPa.
 from __future__ import annotations
 
 import argparse
+import functools
 import sys
 import time
 
@@ -50,8 +51,12 @@ N_LOAD = 16
 
 def run(level: int, mu: float, k: float, width: float, predictor: str, quadrature="gauss",
         comm=MPI.COMM_WORLD, verbose=False, reversal_stiffness=1.0, augmented=False,
-        al_tol=1e-3, continuation=None, linear_solver="auto", residual_ratio=1e-2) -> dict:
+        al_tol=1e-3, continuation=None, linear_solver="auto", residual_ratio=1e-2,
+        basis="standard") -> dict:
     mesh_size, contact_size = LEVELS[level]
+    # flat_punch.build has no argument for the nodal set's basis yet: its interface class
+    # with the basis bound (the scene calls it with its usual arguments)
+    flat_punch.NodalContactInterface = functools.partial(NodalContactInterface, basis=basis)
     law = SoftplusPenalty(k_normal=k, width=width, k_tangential=k, friction=mu,
                           reversal_stiffness=reversal_stiffness)
     if augmented == 2:     # multipliers updated inside the Newton iteration (nodal points)
@@ -60,13 +65,16 @@ def run(level: int, mu: float, k: float, width: float, predictor: str, quadratur
         enforcement = AugmentedLagrangian(tolerance=al_tol)
     else:
         enforcement = Penalty()
-    m = flat_punch.build(comm, mesh_size=mesh_size, contact_size=contact_size, order=1,
-                         load_half_width=10.0, law=law, steps=N_LOAD,
-                         quadrature="gauss" if quadrature == "nodal" else quadrature,
-                         points="nodal" if quadrature == "nodal" else "quadrature",
-                         enforcement=enforcement,
-                         solver_options=dict(continuation=continuation,
-                                             linear_solver=linear_solver))
+    try:
+        m = flat_punch.build(comm, mesh_size=mesh_size, contact_size=contact_size, order=1,
+                             load_half_width=10.0, law=law, steps=N_LOAD,
+                             quadrature="gauss" if quadrature == "nodal" else quadrature,
+                             points="nodal" if quadrature == "nodal" else "quadrature",
+                             enforcement=enforcement,
+                             solver_options=dict(continuation=continuation,
+                                                 linear_solver=linear_solver))
+    finally:
+        flat_punch.NodalContactInterface = NodalContactInterface
     factors = load_unload_factors(N_LOAD, N_LOAD - 1, final_factor=1.0 / N_LOAD)
     t0 = time.process_time()
     exact = (float("nan"), float("nan"))
@@ -90,7 +98,7 @@ def run(level: int, mu: float, k: float, width: float, predictor: str, quadratur
                continuation=("none" if cont is None else
                              ",".join(f"{f:g}" for f in cont.factors)
                              + ("" if cont.after is None else f"/{cont.after}")),
-               linear_solver=m.solver.option_set,
+               linear_solver=m.solver.option_set, basis=basis,
                al_updates=sum(i.augmentations for i in incs),
                newton_updates=(m.interface.newton_updates
                                if isinstance(m.interface, NodalContactInterface) else 0),
@@ -142,6 +150,9 @@ def main(argv=None):
                     "--quadrature nodal only)")
     ap.add_argument("--al-tol", type=float, default=1e-3,
                     help="AugmentedLagrangian.tolerance")
+    ap.add_argument("--basis", nargs="+", default=["standard"], choices=["standard", "dual"],
+                    help="the nodal set's vertex weights (NodalContactInterface basis): the "
+                    "vertex functions or their dual (biorthogonal) basis")
     ap.add_argument("--residual-ratio", type=float, default=1e-2,
                     help="NewtonAugmentedLagrangian.residual_ratio (--augmented 2)")
     ap.add_argument("--continuation", nargs="+", default=["100,10"],
@@ -165,10 +176,13 @@ def main(argv=None):
     for level in args.levels:
         for mu in args.mu:
             for k in args.k:
-                for pred, quad, rs, al, co, ls in [
-                        (a, b, c, d, e, f) for a in args.predictor for b in args.quadrature
+                for pred, quad, rs, al, co, ls, basis in [
+                        (a, b, c, d, e, f, g) for a in args.predictor for b in args.quadrature
                         for c in args.reversal_stiffness for d in args.augmented
-                        for e in args.continuation for f in args.linear_solver]:
+                        for e in args.continuation for f in args.linear_solver
+                        for g in args.basis]:
+                    if basis == "dual" and quad != "nodal":
+                        continue
                     w = args.width if args.width is not None else 1e-2 * 2.5 / k
                     cont = (None if co == "none" else Continuation(
                         tuple(float(x) for x in co.split(",")),
@@ -178,11 +192,11 @@ def main(argv=None):
                     r = run(level, mu, k, w, pred, quad, verbose=args.verbose,
                             reversal_stiffness=rs, augmented=al, al_tol=args.al_tol,
                             continuation=cont, linear_solver=ls,
-                            residual_ratio=args.residual_ratio)
+                            residual_ratio=args.residual_ratio, basis=basis)
                     rows.append(r)
                     PETSc.Sys.Print(
                         f"{r['level']:5d} {r['dofs']:7d} {r['points']:6d} {mu:4.2f} {k:7.1e} "
-                        f"{rs:4.2g} {pred + '/' + quad[0]:>9} {al:2d} {r['al_updates']:4d} "
+                        f"{rs:4.2g} {pred + '/' + quad[0] + ('*' if basis == 'dual' else ''):>9} {al:2d} {r['al_updates']:4d} "
                         f"{r['newton_updates']:5d} "
                         f"{r['continuation']:>10} {r['linear_solver']:>6} "
                         f"{r['newton']:6d} "

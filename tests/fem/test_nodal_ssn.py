@@ -41,19 +41,20 @@ def _roller(V, scene, name, comp):
     return fem.dirichletbc(PETSc.ScalarType(0.0), dofs, V.sub(comp))
 
 
-def _patch(comm, pairing, order):
+def _patch(comm, pairing, order, basis="standard", cell_type="tetrahedron"):
     """Uniform pressure on the top of two blocks on rollers, one increment."""
     if pairing == "conforming":
-        scene = two_blocks(h1=1.0, h2=0.5, mesh_size=0.3, order=order, comm=comm)
+        scene = two_blocks(h1=1.0, h2=0.5, mesh_size=0.3, order=order, comm=comm,
+                           cell_type=cell_type)
     else:
         scene = separate_blocks(h1=1.0, h2=0.5, size_lower=0.2, size_upper=0.28, order=order,
-                                comm=comm)
+                                comm=comm, cell_type=cell_type)
     V = compat.vector_space(scene.mesh, order)
     bcs = [_roller(V, scene, "x0", 0), _roller(V, scene, "y0", 1),
            _roller(V, scene, "bottom", 2)]
     law = SoftplusPenalty(K, 1e-7, k_tangential=K, friction=MU)
     ci = NodalContactInterface(V, scene.facet_tags, *scene.contact_pair, law=law, bcs=bcs,
-                               quadrature_degree=2 * order, pairing=pairing,
+                               quadrature_degree=2 * order, pairing=pairing, basis=basis,
                                enforcement=NewtonAugmentedLagrangian(tolerance=1e-9,
                                                                      max_updates=50))
     mats = {scene.tag("upper"): Material(E, NU), scene.tag("lower"): Material(E, NU)}
@@ -73,14 +74,23 @@ def _patch(comm, pairing, order):
         pressure=np.concatenate(c.allgather(pf.pressure))[order_],
         shear=np.concatenate(c.allgather(pf.shear))[order_],
         gap=np.concatenate(c.allgather(pf.gap))[order_],
-        slipping=c.allreduce(int(pf.slipping.sum()), op=MPI.SUM))
+        slipping=c.allreduce(int(pf.slipping.sum()), op=MPI.SUM),
+        width=c.allreduce(ci.nodal.B.shape[2] // 3 if ci.n_points else 0, op=MPI.MAX))
     solver.destroy()
     return out
 
 
-@pytest.mark.parametrize("pairing,order", [("conforming", 1), ("mortar", 2)])
-def test_patch_exact_and_rank_independent(pairing, order):
-    world = _patch(MPI.COMM_WORLD, pairing, order)
+PATCH = [("conforming", 1, "standard", "tetrahedron"), ("mortar", 2, "standard", "tetrahedron"),
+         ("conforming", 1, "dual", "tetrahedron"), ("mortar", 1, "dual", "tetrahedron"),
+         ("mortar", 2, "dual", "tetrahedron"), ("mortar", 1, "dual", "hexahedron")]
+
+
+@pytest.mark.parametrize("case", PATCH, ids=lambda c: f"{c[0]}-P{c[1]}-{c[2]}-{c[3][:3]}")
+def test_patch_exact_and_rank_independent(case):
+    """Exact transmission of a uniform pressure (the standard and the dual vertex weights
+    are both partitions of unity); serial = 2 ranks."""
+    pairing, order, basis, cell = case
+    world = _patch(MPI.COMM_WORLD, pairing, order, basis, cell)
     assert world["incs"][-1].cutbacks == 0
     assert world["updates"] > 0                     # the route was taken
     np.testing.assert_allclose(world["pressure"], PRESSURE, rtol=0, atol=1e-8 * PRESSURE)
@@ -88,7 +98,9 @@ def test_patch_exact_and_rank_independent(pairing, order):
     # the penalty alone would leave k |g| = p - p(0); exact: the gap closes
     assert np.max(K * np.abs(world["gap"])) <= 1e-6 * PRESSURE
     np.testing.assert_allclose(world["force"], [0.0, 0.0, PRESSURE], atol=1e-8 * PRESSURE)
-    serial = _patch(MPI.COMM_SELF, pairing, order)
+    if basis == "dual" and pairing == "conforming" and order == 1:
+        assert world["width"] == 2      # node to node: the vertex and its partner only
+    serial = _patch(MPI.COMM_SELF, pairing, order, basis, cell)
     np.testing.assert_allclose(world["pressure"], serial["pressure"], rtol=0,
                                atol=1e-10 * PRESSURE)
     np.testing.assert_allclose(world["force"], serial["force"], rtol=0, atol=1e-10 * PRESSURE)
