@@ -115,17 +115,23 @@ def test_bad_arguments(kwargs, name):
         NewtonAugmentedLagrangian(**kwargs)
 
 
-def _punch(enforcement, comm=MPI.COMM_WORLD):
+def _punch(enforcement, comm=MPI.COMM_WORLD, basis="standard"):
     """GetFEM's flat punch on a coarse mesh, P1, Coulomb mu = 0.2, 4 loading and 3
     unloading increments: dissipation per increment, vertex tractions at the end, exactness
     at the peak (largest k_T |s - s_p| over the sticking vertices / largest traction)."""
+    import functools
     from rough_contact.scenes import flat_punch
     from rough_contact.solver.loading import load_unload_factors
     k = 1e7
     law = SoftplusPenalty(k_normal=k, width=2.5e-9, k_tangential=k, friction=0.2)
-    m = flat_punch.build(comm, mesh_size=20.0, contact_size=2.0, order=1, load_half_width=10.0,
-                         law=law, steps=4, points="nodal", enforcement=enforcement,
-                         prefix="test_ssn_punch_", solver_options=dict(linear_solver="mumps"))
+    flat_punch.NodalContactInterface = functools.partial(NodalContactInterface, basis=basis)
+    try:     # the scene has no argument for the basis: its interface class with it bound
+        m = flat_punch.build(comm, mesh_size=20.0, contact_size=2.0, order=1,
+                             load_half_width=10.0, law=law, steps=4, points="nodal",
+                             enforcement=enforcement, prefix="test_ssn_punch_",
+                             solver_options=dict(linear_solver="mumps"))
+    finally:
+        flat_punch.NodalContactInterface = NodalContactInterface
     D, stick_err = [], None
     for inc in load_path(m.problem, m.solver, load_unload_factors(4, 3, final_factor=0.25)):
         D.append(inc.dissipation)
@@ -148,29 +154,30 @@ def _punch(enforcement, comm=MPI.COMM_WORLD):
     return np.array(D), t, stick_err
 
 
-@pytest.fixture(scope="module")
-def punch_newton():
-    return _punch(NewtonAugmentedLagrangian(tolerance=1e-8, max_updates=30))
+@pytest.fixture(scope="module", params=["standard", "dual"])
+def punch_newton(request):
+    return request.param, _punch(NewtonAugmentedLagrangian(tolerance=1e-8, max_updates=30),
+                                 basis=request.param)
 
 
 def test_punch_same_answer_as_uzawa(punch_newton):
     """Uzawa's route (a Newton solve per multiplier update) reaches the same dissipation
     history and vertex tractions; the sticking vertices do not slip elastically; the plain
     penalty's dissipation differs by more than the agreement asked (the check can fail)."""
-    D, t, (stick_err, n_stick) = punch_newton
-    D_u, t_u, _ = _punch(AugmentedLagrangian(tolerance=1e-8, max_updates=30))
+    basis, (D, t, (stick_err, n_stick)) = punch_newton
+    D_u, t_u, _ = _punch(AugmentedLagrangian(tolerance=1e-8, max_updates=30), basis=basis)
     assert n_stick > 0 and D[-1] > 0.0
     assert stick_err <= 1e-7
     np.testing.assert_allclose(D, D_u, rtol=1e-5, atol=1e-6 * D_u[-1])
     np.testing.assert_allclose(t, t_u, rtol=0, atol=1e-5 * np.abs(t_u).max())
-    D_p, _, _ = _punch(Penalty())
+    D_p, _, _ = _punch(Penalty(), basis=basis)
     assert abs(D_p[-1] - D_u[-1]) > 1e-3 * D_u[-1]
 
 
 def test_punch_rank_independent(punch_newton):
     """Serial = all ranks to 1e-10 (dissipation history, vertex tractions)."""
-    D, t, _ = punch_newton
+    basis, (D, t, _) = punch_newton
     D_s, t_s, _ = _punch(NewtonAugmentedLagrangian(tolerance=1e-8, max_updates=30),
-                         MPI.COMM_SELF)
+                         MPI.COMM_SELF, basis)
     np.testing.assert_allclose(D, D_s, rtol=1e-10, atol=1e-14)
     np.testing.assert_allclose(t, t_s, rtol=0, atol=1e-10 * np.abs(t_s).max())
