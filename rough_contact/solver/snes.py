@@ -441,13 +441,6 @@ class SNESSolver:
         finally:
             step.destroy()
         return fnorm
-        if fnorm < atol:
-            return reasons.CONVERGED_FNORM_ABS
-        if iteration > 0 and fnorm <= self._ttol:
-            return reasons.CONVERGED_FNORM_RELATIVE
-        if iteration > 0 and ynorm < stol * xnorm:
-            return reasons.CONVERGED_SNORM_RELATIVE
-        return reasons.ITERATING
 
     def _set_near_nullspace(self, near_nullspace) -> None:
         """Rigid-body modes for the algebraic multigrid preconditioners (else none)."""
