@@ -12,8 +12,8 @@ relative to the largest traction (about 1 for a penalty, the tolerance for exact
 
     OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bench_coulomb_punch.py \\
         [--levels 1 2 3] [--mu 0.2 0.5] [--k 1e7] [--predictor none secant]
-        [--quadrature gauss vertex nodal] [--reversal-stiffness 0 1] [--augmented 0 1 2] [--al-tol 1e-3]
-        [--basis standard dual] [--residual-ratio 1e-2]
+        [--quadrature gauss vertex nodal] [--reversal-stiffness 0 1] [--augmented 0 1 2]
+        [--al-tol 1e-3] [--basis standard dual] [--residual-ratio 1e-2]
         [--continuation none 100,10] [--after 10] [--linear-solver auto mumps hypre] [--csv FILE]
 
 Levels (P1; mesh and contact size in LEVELS): 1 ~4.5 k DOFs, 2 ~26 k, 3 ~73 k, 4 ~99 k (the size
@@ -195,9 +195,10 @@ def main(argv=None):
                             continuation=cont, linear_solver=ls,
                             residual_ratio=args.residual_ratio, basis=basis)
                     rows.append(r)
+                    label = pred + "/" + quad[0] + ("*" if basis == "dual" else "")
                     PETSc.Sys.Print(
                         f"{r['level']:5d} {r['dofs']:7d} {r['points']:6d} {mu:4.2f} {k:7.1e} "
-                        f"{rs:4.2g} {pred + '/' + quad[0] + ('*' if basis == 'dual' else ''):>9} {al:2d} {r['al_updates']:4d} "
+                        f"{rs:4.2g} {label:>9} {al:2d} {r['al_updates']:4d} "
                         f"{r['newton_updates']:5d} "
                         f"{r['continuation']:>10} {r['linear_solver']:>6} "
                         f"{r['newton']:6d} "

@@ -344,11 +344,11 @@ class NodalContactInterface(ContactInterface):
         """The Newton solver's per-iteration hook (``rough_contact.solver.snes.
         NewtonIterationHook``; collective): with ``NewtonAugmentedLagrangian``, from Newton
         iteration ``first_iteration`` on and at iterates whose residual norm ``residual`` is at
-        most ``residual_ratio`` x the solve's first one (``first``), lambda <- the tractions of the last evaluation (the
-        current iterate: the solver evaluates the residual at an iterate before starting the
-        iteration from it) if that moves the multipliers by more than the tolerance (largest
-        change over all vertices and ranks / largest traction magnitude). Not during a
-        penalty continuation's softened solves. Returns whether the multipliers changed (the
+        most ``residual_ratio`` x the solve's first one (``first``), lambda <- the tractions
+        of the last evaluation (the current iterate: the solver evaluates the residual at an
+        iterate before starting the iteration from it) if that moves the multipliers by more
+        than the tolerance (largest change over all vertices and ranks / largest traction
+        magnitude). Not during a penalty continuation's softened solves. Returns whether the multipliers changed (the
         residual must be evaluated again); counts the updates in ``newton_updates``."""
         enf = self.enforcement
         if (not isinstance(enf, NewtonAugmentedLagrangian) or self._softened is not None
