@@ -6,11 +6,14 @@ punch top (1000 N on the full punch), 16 loading increments and 16 unloading one
 of the load (a punch held only by a penalty contact has no equilibrium at zero load),
 isotropic Coulomb friction (``SoftplusPenalty``). Prints per run: DOFs, interface points,
 Newton iterations (all attempts, including failed ones), cutbacks, the largest count in one
-increment, CPU time and the dissipation at the peak and at the end.
+increment, CPU time, the dissipation at the peak and at the end, and at the peak the largest
+k_N |g| over the points in contact (kg/t) and k_T |s - s_p| over the sticking ones (kTs/t),
+relative to the largest traction (about 1 for a penalty, the tolerance for exact enforcement).
 
     OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bench_coulomb_punch.py \\
         [--levels 1 2 3] [--mu 0.2 0.5] [--k 1e7] [--predictor none secant]
-        [--quadrature gauss vertex nodal] [--reversal-stiffness 0 1] [--augmented 0 1] [--al-tol 1e-3]
+        [--quadrature gauss vertex nodal] [--reversal-stiffness 0 1] [--augmented 0 1 2]
+        [--al-tol 1e-3] [--basis standard dual] [--residual-ratio 1e-2]
         [--continuation none 100,10] [--after 10] [--linear-solver auto mumps hypre] [--csv FILE]
 
 Levels (P1; mesh and contact size in LEVELS): 1 ~4.5 k DOFs, 2 ~26 k, 3 ~73 k, 4 ~99 k (the size
@@ -21,6 +24,7 @@ Units: mm, N, MPa.
 from __future__ import annotations
 
 import argparse
+import functools
 import sys
 import time
 
@@ -33,7 +37,9 @@ import numpy as np  # noqa: E402
 from mpi4py import MPI  # noqa: E402
 from petsc4py import PETSc  # noqa: E402
 
-from rough_contact.interface.enforcement import AugmentedLagrangian, Penalty
+from rough_contact.fem.nodal import NodalContactInterface
+from rough_contact.interface.enforcement import (AugmentedLagrangian, NewtonAugmentedLagrangian,
+                                                 Penalty)
 from rough_contact.interface.penalty import SoftplusPenalty
 from rough_contact.scenes import flat_punch
 from rough_contact.solver.loading import LoadStepError, load_path, load_unload_factors
@@ -46,26 +52,41 @@ N_LOAD = 16
 
 def run(level: int, mu: float, k: float, width: float, predictor: str, quadrature="gauss",
         comm=MPI.COMM_WORLD, verbose=False, reversal_stiffness=1.0, augmented=False,
-        al_tol=1e-3, continuation=None, linear_solver="auto") -> dict:
+        al_tol=1e-3, continuation=None, linear_solver="auto", residual_ratio=1e-2,
+        basis="standard") -> dict:
     mesh_size, contact_size = LEVELS[level]
+    # flat_punch.build has no argument for the nodal set's basis yet: its interface class
+    # with the basis bound (the scene calls it with its usual arguments)
+    flat_punch.NodalContactInterface = functools.partial(NodalContactInterface, basis=basis)
     law = SoftplusPenalty(k_normal=k, width=width, k_tangential=k, friction=mu,
                           reversal_stiffness=reversal_stiffness)
-    enforcement = AugmentedLagrangian(tolerance=al_tol) if augmented else Penalty()
-    m = flat_punch.build(comm, mesh_size=mesh_size, contact_size=contact_size, order=1,
-                         load_half_width=10.0, law=law, steps=N_LOAD,
-                         quadrature="gauss" if quadrature == "nodal" else quadrature,
-                         points="nodal" if quadrature == "nodal" else "quadrature",
-                         enforcement=enforcement,
-                         solver_options=dict(continuation=continuation,
-                                             linear_solver=linear_solver))
+    if augmented == 2:     # multipliers updated inside the Newton iteration (nodal points)
+        enforcement = NewtonAugmentedLagrangian(tolerance=al_tol, residual_ratio=residual_ratio)
+    elif augmented:
+        enforcement = AugmentedLagrangian(tolerance=al_tol)
+    else:
+        enforcement = Penalty()
+    try:
+        m = flat_punch.build(comm, mesh_size=mesh_size, contact_size=contact_size, order=1,
+                             load_half_width=10.0, law=law, steps=N_LOAD,
+                             quadrature="gauss" if quadrature == "nodal" else quadrature,
+                             points="nodal" if quadrature == "nodal" else "quadrature",
+                             enforcement=enforcement,
+                             solver_options=dict(continuation=continuation,
+                                                 linear_solver=linear_solver))
+    finally:
+        flat_punch.NodalContactInterface = NodalContactInterface
     factors = load_unload_factors(N_LOAD, N_LOAD - 1, final_factor=1.0 / N_LOAD)
     t0 = time.process_time()
+    exact = (float("nan"), float("nan"))
     incs = []
     kwargs = {"predictor": predictor}
     failed = ""
     try:
         for inc in load_path(m.problem, m.solver, factors, verbose=verbose, **kwargs):
             incs.append(inc)
+            if inc.load_factor == 1.0:
+                exact = _exactness(m.interface, law, comm)
     except LoadStepError as exc:     # reported as a row: the run did not complete
         failed = f"LoadStepError at load factor {exc.load_factor:.6g}"
         PETSc.Sys.Print(f"  FAILED: {exc}")
@@ -78,8 +99,10 @@ def run(level: int, mu: float, k: float, width: float, predictor: str, quadratur
                continuation=("none" if cont is None else
                              ",".join(f"{f:g}" for f in cont.factors)
                              + ("" if cont.after is None else f"/{cont.after}")),
-               linear_solver=m.solver.option_set,
+               linear_solver=m.solver.option_set, basis=basis,
                al_updates=sum(i.augmentations for i in incs),
+               newton_updates=(m.interface.newton_updates
+                               if isinstance(m.interface, NodalContactInterface) else 0),
                newton=sum(i.newton_total for i in incs),
                solves=len(incs) + sum(i.failed_attempts for i in incs),
                cutbacks=sum(i.cutbacks for i in incs),
@@ -87,9 +110,26 @@ def run(level: int, mu: float, k: float, width: float, predictor: str, quadratur
                D_peak=peak.dissipation if peak else float("nan"),
                D_end=float("nan") if failed else incs[-1].dissipation,
                slip_peak=peak.n_slipping / max(peak.n_points, 1) if peak else float("nan"),
+               gap_peak=exact[0], stick_peak=exact[1],
                failed=failed)
     m.solver.destroy()
     return out
+
+
+def _exactness(interface, law, comm) -> tuple:
+    """At the current (converged) state: the largest k_N |g| over the points in contact and
+    the largest k_T |s - s_p| (the elastic slip) over the sticking ones, both relative to the
+    largest traction magnitude [-]. About 1 for a penalty (its compliance), about the
+    augmentation tolerance for exact enforcement."""
+    pf = interface.point_fields()
+    stick = pf.contact & ~pf.slipping
+    t = np.hypot(pf.pressure, np.linalg.norm(pf.shear, axis=1))
+    vals = np.array([np.max(law.k_normal * np.abs(pf.gap[pf.contact]), initial=0.0),
+                     np.max(law.k_tangential * np.linalg.norm(
+                         (pf.slip - pf.plastic_slip)[stick], axis=1), initial=0.0),
+                     np.max(t, initial=0.0)])
+    comm.Allreduce(MPI.IN_PLACE, vals, op=MPI.MAX)
+    return vals[0] / vals[2], vals[1] / vals[2]
 
 
 def main(argv=None):
@@ -105,10 +145,17 @@ def main(argv=None):
                     "nodal point set through the Gauss rule (rough_contact.fem.nodal)")
     ap.add_argument("--reversal-stiffness", type=float, nargs="+", default=[1.0],
                     help="SoftplusPenalty.reversal_stiffness (0 = consistent tangent everywhere)")
-    ap.add_argument("--augmented", type=int, nargs="+", default=[0], choices=[0, 1],
-                    help="1 = augmented Lagrangian (Uzawa) on top of the penalty")
+    ap.add_argument("--augmented", type=int, nargs="+", default=[0], choices=[0, 1, 2],
+                    help="1 = augmented Lagrangian (Uzawa) on top of the penalty; 2 = the "
+                    "multipliers updated inside the Newton iteration (NewtonAugmentedLagrangian, "
+                    "--quadrature nodal only)")
     ap.add_argument("--al-tol", type=float, default=1e-3,
                     help="AugmentedLagrangian.tolerance")
+    ap.add_argument("--basis", nargs="+", default=["standard"], choices=["standard", "dual"],
+                    help="the nodal set's vertex weights (NodalContactInterface basis): the "
+                    "vertex functions or their dual (biorthogonal) basis")
+    ap.add_argument("--residual-ratio", type=float, default=1e-2,
+                    help="NewtonAugmentedLagrangian.residual_ratio (--augmented 2)")
     ap.add_argument("--continuation", nargs="+", default=["100,10"],
                     help="penalty continuation: softening factors (default 100,10, the "
                          "solver's) or none (rough_contact.solver.snes.Continuation)")
@@ -123,33 +170,42 @@ def main(argv=None):
     args, _petsc = ap.parse_known_args(argv)   # the rest goes to PETSc
     rows = []
     head = (f"{'level':>5} {'DOFs':>7} {'points':>6} {'mu':>4} {'k':>7} {'rev':>4} "
-            f"{'predictor':>9} {'AL':>2} {'upd':>4} {'cont':>10} {'linear':>6} "
+            f"{'predictor':>9} {'AL':>2} {'upd':>4} {'Nupd':>5} {'cont':>10} {'linear':>6} "
             f"{'Newton':>6} {'solves':>6} {'cutb':>4} {'max/inc':>7} {'CPU s':>7} "
-            f"{'D peak':>10} {'D end':>10} {'slip':>5}")
+            f"{'D peak':>10} {'D end':>10} {'slip':>5} {'kg/t':>8} {'kTs/t':>8}")
     PETSc.Sys.Print(head)
     for level in args.levels:
         for mu in args.mu:
             for k in args.k:
-                for pred, quad, rs, al, co, ls in [
-                        (a, b, c, d, e, f) for a in args.predictor for b in args.quadrature
+                for pred, quad, rs, al, co, ls, basis in [
+                        (a, b, c, d, e, f, g) for a in args.predictor for b in args.quadrature
                         for c in args.reversal_stiffness for d in args.augmented
-                        for e in args.continuation for f in args.linear_solver]:
+                        for e in args.continuation for f in args.linear_solver
+                        for g in args.basis]:
+                    if basis == "dual" and quad != "nodal":
+                        continue
                     w = args.width if args.width is not None else 1e-2 * 2.5 / k
                     cont = (None if co == "none" else Continuation(
                         tuple(float(x) for x in co.split(",")),
                         None if args.after == "none" else int(args.after)))
+                    if al == 2 and quad != "nodal":
+                        continue       # the in-Newton update is the nodal point set's
                     r = run(level, mu, k, w, pred, quad, verbose=args.verbose,
-                            reversal_stiffness=rs, augmented=bool(al), al_tol=args.al_tol,
-                            continuation=cont, linear_solver=ls)
+                            reversal_stiffness=rs, augmented=al, al_tol=args.al_tol,
+                            continuation=cont, linear_solver=ls,
+                            residual_ratio=args.residual_ratio, basis=basis)
                     rows.append(r)
+                    label = pred + "/" + quad[0] + ("*" if basis == "dual" else "")
                     PETSc.Sys.Print(
                         f"{r['level']:5d} {r['dofs']:7d} {r['points']:6d} {mu:4.2f} {k:7.1e} "
-                        f"{rs:4.2g} {pred + '/' + quad[0]:>9} {al:2d} {r['al_updates']:4d} "
+                        f"{rs:4.2g} {label:>9} {al:2d} {r['al_updates']:4d} "
+                        f"{r['newton_updates']:5d} "
                         f"{r['continuation']:>10} {r['linear_solver']:>6} "
                         f"{r['newton']:6d} "
                         f"{r['solves']:6d} {r['cutbacks']:4d} "
                         f"{r['max_its']:7d} {r['cpu']:7.1f} {r['D_peak']:10.4e} "
-                        f"{r['D_end']:10.4e} {r['slip_peak']:5.2f}"
+                        f"{r['D_end']:10.4e} {r['slip_peak']:5.2f} {r['gap_peak']:8.1e} "
+                        f"{r['stick_peak']:8.1e}"
                         + (f"  FAILED ({r['failed']})" if r["failed"] else ""))
     if args.csv and MPI.COMM_WORLD.rank == 0:
         write_csv(args.csv, rows)

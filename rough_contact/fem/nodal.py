@@ -48,6 +48,7 @@ from rough_contact.fem.contact import ContactInterface
 from rough_contact.fem.jump import JumpOperator
 from rough_contact.fem.pairing.base import PairedPoints, SurfaceContext, local_frames
 from rough_contact.fem.pairing.facets import basix_cell
+from rough_contact.interface.enforcement import NewtonAugmentedLagrangian
 
 __all__ = ["NodalContactInterface", "NodalPoints", "VertexJumpOperator", "nodal_points",
            "vertex_shape_matrix"]
@@ -104,12 +105,33 @@ def vertex_shape_matrix(V) -> tuple[np.ndarray, np.ndarray]:
     return M, vertex_closure
 
 
-def nodal_points(ctx: SurfaceContext, paired: PairedPoints, op: JumpOperator) -> NodalPoints:
+def dual_matrix(nv: int) -> np.ndarray:
+    """(nv, nv) D with psi_i = sum_j N_j D[j, i] the dual (biorthogonal) basis of the
+    first-order vertex functions N_j of a facet: int psi_i N_k dA = delta_ik int N_k dA on
+    a flat triangle (nv = 3: psi_i = 4 N_i - 1) or a parallelogram (nv = 4: the tensor product
+    of the segment's 2 N_1 - N_2, in basix's vertex order (0,0), (1,0), (0,1), (1,1)); the
+    psi_i sum to 1 (a partition of unity, as the N_i)."""
+    if nv == 3:
+        return 4.0 * np.eye(3) - 1.0
+    if nv == 4:
+        a = np.array([[2.0, -1.0], [-1.0, 2.0]])
+        return np.kron(a, a)          # vertex v = x + 2 y: kron over (y, x) is symmetric here
+    raise ValueError(f"a facet with {nv} vertices has no dual basis here (3 or 4)")
+
+
+def nodal_points(ctx: SurfaceContext, paired: PairedPoints, op: JumpOperator,
+                 basis: str = "standard") -> NodalPoints:
     """The vertex points of the first surface from the pairing's points (collective).
 
     Args:
         ctx: the first surface; paired: the pairing's points; op: their jump operator (its
             per-point rows and the DOFs of its groups; Dirichlet rows are not used).
+        basis: the weight of the vertex jumps: ``"standard"`` (N_j) or ``"dual"`` (the
+            biorthogonal psi_j of :func:`dual_matrix`; the weights m_j and normals stay those
+            of N_j, int psi_j = int N_j). With P1 displacements the dual weighted jump of
+            vertex j involves the first surface's DOFs of j alone (and, on a conforming
+            pairing, the second's of its partner alone): entries below 1e-12 m_j are dropped,
+            a sparser Jacobian.
 
     Raises:
         ValueError (every rank): a vertex with zero weight.
@@ -122,19 +144,22 @@ def nodal_points(ctx: SurfaceContext, paired: PairedPoints, op: JumpOperator) ->
     Nv = np.einsum("fqk,fkv->fqv", paired.N1, M[lf])                  # (n_f, nq, nv)
     vid = np.take_along_axis(paired.nodes1, vclose[lf], axis=1)       # (n_f, nv)
     c = paired.weights.reshape(n_f, nq, 1) * Nv                       # w_q N_j(x_q)
+    if basis not in ("standard", "dual"):
+        raise ValueError(f"basis = {basis!r} is invalid: 'standard' or 'dual'")
+    cj = c if basis == "standard" else c @ dual_matrix(nv)            # the jump's weights
     R = paired.frames.reshape(n_f, nq, 3, 3)
     jump0 = paired.jump0.copy()
     jump0[:, 0] += op.gap0
     # per (facet, vertex): weight, weighted normal, weighted initial jump (global components)
     m_fv = c.sum(axis=1)
     n_fv = np.einsum("fqv,fqi->fvi", c, R[:, :, 0, :])
-    j0_fv = np.einsum("fqv,fqai,fqa->fvi", c, R, jump0.reshape(n_f, nq, 3))
+    j0_fv = np.einsum("fqv,fqai,fqa->fvi", cj, R, jump0.reshape(n_f, nq, 3))
     # per (group, vertex): the weighted rows sum_q c R_q^T B_q on the group's DOFs
     n_g, nqs, nd = op.n_groups, op.nqs, op._B.shape[2]
     own = np.flatnonzero(op.own_slot)
     slot = op._point_slot[own]
     cs = np.zeros((n_g * nqs, nv))
-    cs[slot] = c.reshape(-1, nv)[own]
+    cs[slot] = cj.reshape(-1, nv)[own]
     Rs = np.zeros((n_g * nqs, 3, 3))
     Rs[slot] = paired.frames[own]
     Bg = np.einsum("sai,sad->sid", Rs, op._B).reshape(n_g, nqs, 3, nd)
@@ -193,6 +218,9 @@ def nodal_points(ctx: SurfaceContext, paired: PairedPoints, op: JumpOperator) ->
                      for k in range(9)], axis=1).reshape(-1, 3, 3) if ukey.size else \
         np.zeros((0, 3, 3))
     kv, kn = ukey // n_glob, ukey % n_glob
+    if basis == "dual":     # biorthogonality: the other first-surface DOFs vanish (round-off)
+        big = np.abs(vals).reshape(-1, 9).max(axis=1, initial=0.0) > 1e-12 * m[kv]
+        ukey, vals, kv, kn = ukey[big], vals[big], kv[big], kn[big]
     counts = np.bincount(kv, minlength=n_v)
     width = int(counts.max(initial=1))
     starts = np.cumsum(counts) - counts
@@ -282,17 +310,23 @@ class NodalContactInterface(ContactInterface):
 
     _constraints_per_point = False
 
-    def __init__(self, V, facet_tags, first_tag, second_tag=None, **kwargs):
+    def __init__(self, V, facet_tags, first_tag, second_tag=None, basis: str = "standard",
+                 **kwargs):
+        if basis not in ("standard", "dual"):
+            raise ValueError(f"basis = {basis!r} is invalid: 'standard' (the vertex functions "
+                             "N_j) or 'dual' (their biorthogonal basis)")
+        self.basis = basis
         sliding = kwargs.get("sliding", "small")
         if sliding != "small":
             raise ValueError(f"sliding = {sliding!r} is invalid for the nodal point set: only "
                              "'small' (the vertex rows are built once at set-up)")
         super().__init__(V, facet_tags, first_tag, second_tag, **kwargs)
+        self.newton_updates = 0      # multiplier updates inside Newton iterations (all solves)
 
     def _point_set(self, ctx: SurfaceContext, bcs: Sequence) -> JumpOperator:
         quad = JumpOperator(ctx.V, self.paired, bcs=bcs)
         self.quadrature_points = self.paired
-        self.nodal = nodal_points(ctx, self.paired, quad)
+        self.nodal = nodal_points(ctx, self.paired, quad, self.basis)
         nodal = self.nodal
         n_v = nodal.vertex.size
         self.paired = PairedPoints(
@@ -301,7 +335,44 @@ class NodalContactInterface(ContactInterface):
             nodes1=nodal.vertex[:, None], partners=None, name="nodal")
         return VertexJumpOperator(ctx.V, nodal, bcs=bcs)
 
+    def updates_in_newton(self) -> bool:
+        """Whether the enforcement updates the multipliers inside the Newton iteration
+        (``NewtonAugmentedLagrangian``; the solver's ``NewtonIterationHook``)."""
+        return isinstance(self.enforcement, NewtonAugmentedLagrangian)
+
+    def newton_iteration(self, iteration: int, residual: float, first: float) -> bool:
+        """The Newton solver's per-iteration hook (``rough_contact.solver.snes.
+        NewtonIterationHook``; collective): with ``NewtonAugmentedLagrangian``, from Newton
+        iteration ``first_iteration`` on and at iterates whose residual norm ``residual`` is at
+        most ``residual_ratio`` x the solve's first one (``first``), lambda <- the tractions
+        of the last evaluation (the current iterate: the solver evaluates the residual at an
+        iterate before starting the iteration from it) if that moves the multipliers by more
+        than the tolerance (largest change over all vertices and ranks / largest traction
+        magnitude). Not during a penalty continuation's softened solves. Returns whether the multipliers changed (the
+        residual must be evaluated again); counts the updates in ``newton_updates``."""
+        enf = self.enforcement
+        if (not isinstance(enf, NewtonAugmentedLagrangian) or self._softened is not None
+                or iteration < enf.first_iteration or self._last is None
+                or residual > enf.residual_ratio * first):
+            return False
+        res = self._last
+        update = enf.update(self.history.multipliers, res)
+        top = np.zeros(2)
+        if update.change.size:
+            top[:] = update.change.max(), np.linalg.norm(res.traction, axis=1).max()
+        self.comm.Allreduce(MPI.IN_PLACE, top, op=MPI.MAX)
+        rel = top[0] / top[1] if top[1] > 0.0 else 0.0
+        if rel <= enf.tolerance:
+            return False
+        self.history.set_multipliers(update.multipliers)
+        self._last = None      # the solver evaluates again; the Newton-step memo is kept
+        self.newton_updates += 1
+        return True
+
     def describe(self) -> dict:
         """``ContactInterface.describe`` plus the point set (a checkpoint of the quadrature
         route is not resumed on vertex points, nor the other way round)."""
-        return dict(super().describe(), points="nodal")
+        out = dict(super().describe(), points="nodal")
+        if self.basis != "standard":       # the standard basis keeps its old fingerprint
+            out["basis"] = self.basis
+        return out

@@ -8,7 +8,11 @@ law such as ``SoftplusPenalty`` — can be used
 * with exact constraints (:class:`AugmentedLagrangian`): Uzawa's iteration on per-point
   multipliers, lambda <- the converged tractions, one Newton solve per update, until the
   multipliers stop moving; the law must be a
-  :class:`~rough_contact.interface.contract.MultiplierLaw`.
+  :class:`~rough_contact.interface.contract.MultiplierLaw`;
+* with exact constraints and the multipliers updated inside the Newton iteration
+  (:class:`NewtonAugmentedLagrangian`): lambda <- the tractions at every Newton iterate, the
+  same fixed point as Uzawa's at the cost of about one Newton solve per increment (nodal
+  points, ``rough_contact.fem.nodal``).
 
 A strategy is pure numpy and holds no per-point data: the multipliers live in the interface's
 history (:class:`~rough_contact.interface.state.InterfaceHistory`), the global reductions and
@@ -28,7 +32,8 @@ import numpy as np
 from ..validation import check_scalar
 from .contract import InterfaceLawProtocol, LawResult, MultiplierLaw
 
-__all__ = ["Enforcement", "Penalty", "AugmentedLagrangian", "MultiplierUpdate"]
+__all__ = ["Enforcement", "Penalty", "AugmentedLagrangian", "NewtonAugmentedLagrangian",
+           "MultiplierUpdate"]
 
 
 @dataclass(frozen=True)
@@ -148,3 +153,55 @@ class AugmentedLagrangian:
         new += ratio * (multipliers - previous)
         new[:, 0] = np.maximum(new[:, 0], 0.0)
         return new
+
+
+@dataclass(frozen=True)
+class NewtonAugmentedLagrangian(AugmentedLagrangian):
+    """Exact contact and stick with the multipliers updated inside the Newton iteration.
+
+    The augmented-Lagrangian (Alart-Curnier) fixed point lambda = P_C(lambda + r g~) of
+    :class:`AugmentedLagrangian`, reached without a Newton solve per update: at the start of
+    every Newton iteration (the converged tractions of Uzawa's scheme, here taken at the
+    current iterate) lambda <- [p, t_x, t_y] of the law at the current iterate with the
+    current multipliers, as long as that moves the multipliers by more than ``tolerance``
+    times the largest traction; then the residual is evaluated again with the new multipliers
+    and the Newton step is taken on the penalty tangent. Once the multipliers move by less,
+    they stay fixed and Newton converges quadratically on the penalty law shifted by them.
+    After the Newton solve the interface checks the multipliers as :class:`AugmentedLagrangian`
+    does (``ContactInterface.accept``): if the converged iterate would still move them by more
+    than ``tolerance``, it solves again (counted as an update; rare). The converged answer is
+    that of :class:`AugmentedLagrangian` with the same tolerance; only the path differs.
+
+    For a fixed contact and stick set each update is one Uzawa step, whose error ratio is
+    1 / (1 + r c) (r: the penalty, c: the compliance a vertex multiplier sees); the Newton
+    iteration's own convergence runs alongside.
+
+    Used by the nodal point set (``rough_contact.fem.nodal.NodalContactInterface``), whose
+    per-vertex multipliers carry no more constraints than the surface has vertices; the
+    interface implements the Newton solver's per-iteration hook
+    (``rough_contact.solver.snes.NewtonIterationHook``).
+
+    Args:
+        tolerance, max_updates: as :class:`AugmentedLagrangian` (``max_updates`` bounds the
+            re-solves after a converged Newton solve, not the in-Newton updates).
+        first_iteration: the first Newton iterate (>= 0) at which the multipliers are updated
+            (0: also at the start of a solve, the predicted start or, in a re-solve, the
+            iterate ``accept`` has just updated them at).
+        residual_ratio: the multipliers are updated only at iterates whose residual is at
+            most this fraction (0 <= ratio <= 1) of the solve's first residual [-]: an update
+            far from equilibrium (a Newton step that overshot) feeds the overshoot into the
+            multipliers.
+    """
+
+    first_iteration: int = 1
+    residual_ratio: float = 1e-2
+    name: str = "newton_augmented_lagrangian"
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        check_scalar("residual_ratio", self.residual_ratio, lo=0.0, hi=1.0, lo_open=False,
+                     hi_open=False)
+        if (not isinstance(self.first_iteration, (int, np.integer))
+                or isinstance(self.first_iteration, bool) or self.first_iteration < 0):
+            raise ValueError(f"first_iteration = {self.first_iteration!r} is invalid: it must "
+                             "be an integer >= 0 (Newton iteration)")

@@ -39,7 +39,7 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass, field
-from typing import Mapping, Optional, Union
+from typing import Mapping, Optional, Protocol, Union, runtime_checkable
 
 import numpy as np
 from petsc4py import PETSc
@@ -50,6 +50,7 @@ from rough_contact.solver.options import default_options, set_default_options, u
 from rough_contact.validation import check_scalar
 
 __all__ = ["SolveResult", "SNESSolver", "UnusedOptionsWarning", "set_default_options",
+           "NewtonIterationHook",
            "LINEAR_SOLVERS", "AMG_DEFAULT", "DEFAULT_DOF_THRESHOLD", "Continuation"]
 
 
@@ -163,6 +164,26 @@ def _parse_continuation(text: str) -> Optional[Continuation]:
         raise ValueError(f"continuation = {text!r} is invalid: give 'none' or comma-separated "
                          "softening factors > 1, decreasing (e.g. 100,10)") from None
     return Continuation(factors)
+
+
+@runtime_checkable
+class NewtonIterationHook(Protocol):
+    """An interface that may change its law between Newton iterations (e.g. multipliers
+    updated inside the Newton iteration, ``rough_contact.interface.enforcement.
+    NewtonAugmentedLagrangian``). :class:`SNESSolver` calls :meth:`newton_iteration` in its
+    convergence test, after the residual at Newton iterate ``iteration`` was evaluated; if it
+    returns True, the residual is evaluated again at the same iterate with the changed law and
+    the solve does not stop there."""
+
+    def updates_in_newton(self) -> bool:
+        """Whether :meth:`newton_iteration` may change the law (else the solver ignores the
+        hook: its Newton iteration is PETSc's own)."""
+        ...
+
+    def newton_iteration(self, iteration: int, residual: float, first: float) -> bool:
+        """At Newton iterate ``iteration`` with residual norm ``residual`` [N], ``first`` that
+        of the solve's start (collective): True if the law changed."""
+        ...
 
 
 class UnusedOptionsWarning(UserWarning):
@@ -312,6 +333,14 @@ class SNESSolver:
             "snes_error_if_not_converged": False,
         }
         opts.update(LINEAR_SOLVERS[linear_solver])
+        hook = (isinstance(problem.interface, NewtonIterationHook)
+                and problem.interface.updates_in_newton())
+        if hook:
+            # a law changed between iterations (_converged_with_hook) changes the residual the
+            # next step starts from; PETSc 3.18's backtracking compares the step with the norm
+            # before the change and fails: PETSc takes the full step, the convergence test
+            # backtracks with the current norms
+            opts["snes_linesearch_type"] = "basic"
         opts.update(defaults or {})
         self.defaults = opts  # without prefix; in the database only inside _options()
         # An absolute tolerance given by the user (command line or ``defaults``) is kept as is;
@@ -340,6 +369,78 @@ class SNESSolver:
         self._tighten = None
         self._reported_after_first_solve = False
         self.snes.setMonitor(self._monitor)
+        if hook:
+            self._ttol = self._fnorm0 = self._f_prev = 0.0
+            self._x_prev = None
+            self.snes.setConvergenceTest(self._converged_with_hook)
+
+    def _converged_with_hook(self, snes, iteration, norms):
+        """PETSc's default convergence test (absolute, relative to the first residual, step
+        length) for an interface with a :class:`NewtonIterationHook`, with the line search
+        done here (PETSc's is ``basic``: a full step, evaluated): the residual norm at the
+        full step is compared with the one at the previous iterate as the interface's law then
+        was, and the step is halved until |F| <= (1 - 1e-4 theta) |F_previous| (at most
+        ``_MAX_BACKTRACKS`` times, else DIVERGED_LINE_SEARCH); the iterate and residual are
+        replaced in place. Then the interface may change its law (:meth:`NewtonIterationHook.
+        newton_iteration`): the residual is evaluated again at the same iterate and the solve
+        does not stop there. The monitor has already printed the full step's norm."""
+        xnorm, ynorm, fnorm = (float(v) for v in norms)
+        rtol, atol, stol, _ = snes.getTolerances()
+        reasons = PETSc.SNES.ConvergedReason
+        x, f = snes.getSolution(), snes.getFunction()[0]
+        try:
+            if iteration == 0:
+                self._ttol, self._fnorm0 = fnorm * rtol, fnorm
+                self._x_prev = x.copy()
+            elif np.isfinite(fnorm) and fnorm > self._f_prev:
+                fnorm = self._backtrack(snes, x, f, fnorm)
+            if not np.isfinite(fnorm):
+                return reasons.DIVERGED_FNORM_NAN
+            if iteration > 0 and fnorm > self._f_prev * (1.0 - 1e-12):   # no decrease
+                if fnorm < atol:
+                    return reasons.CONVERGED_FNORM_ABS
+                return (reasons.CONVERGED_FNORM_RELATIVE if fnorm <= self._ttol
+                        else reasons.DIVERGED_LINE_SEARCH)
+            changed = self.problem.interface.newton_iteration(int(iteration), fnorm,
+                                                              self._fnorm0)
+            if changed:
+                self.problem.F(snes, x, f)
+                fnorm = f.norm()
+            self._f_prev = fnorm
+            x.copy(self._x_prev)
+        except Exception as exc:
+            self.problem.callback_error = exc
+            raise
+        if changed:
+            return reasons.ITERATING
+        if fnorm < atol:
+            return reasons.CONVERGED_FNORM_ABS
+        if iteration > 0 and fnorm <= self._ttol:
+            return reasons.CONVERGED_FNORM_RELATIVE
+        if iteration > 0 and ynorm < stol * xnorm:
+            return reasons.CONVERGED_SNORM_RELATIVE
+        return reasons.ITERATING
+
+    _MAX_BACKTRACKS = 12
+
+    def _backtrack(self, snes, x, f, fnorm: float) -> float:
+        """Armijo backtracking on |F| along the full step x - x_prev (in place); the norm
+        reached (its first value that decreases enough, or the last tried)."""
+        step = x.copy()
+        step.axpy(-1.0, self._x_prev)
+        theta = 1.0
+        try:
+            for _ in range(self._MAX_BACKTRACKS):
+                if np.isfinite(fnorm) and fnorm <= (1.0 - 1e-4 * theta) * self._f_prev:
+                    break
+                theta *= 0.5
+                self._x_prev.copy(x)
+                x.axpy(theta, step)
+                self.problem.F(snes, x, f)
+                fnorm = f.norm()
+        finally:
+            step.destroy()
+        return fnorm
 
     def _set_near_nullspace(self, near_nullspace) -> None:
         """Rigid-body modes for the algebraic multigrid preconditioners (else none)."""
