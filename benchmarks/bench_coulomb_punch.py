@@ -24,7 +24,6 @@ Units: mm, N, MPa.
 from __future__ import annotations
 
 import argparse
-import functools
 import sys
 import time
 
@@ -55,9 +54,6 @@ def run(level: int, mu: float, k: float, width: float, predictor: str, quadratur
         al_tol=1e-3, continuation=None, linear_solver="auto", residual_ratio=1e-2,
         basis="standard") -> dict:
     mesh_size, contact_size = LEVELS[level]
-    # flat_punch.build has no argument for the nodal set's basis yet: its interface class
-    # with the basis bound (the scene calls it with its usual arguments)
-    flat_punch.NodalContactInterface = functools.partial(NodalContactInterface, basis=basis)
     law = SoftplusPenalty(k_normal=k, width=width, k_tangential=k, friction=mu,
                           reversal_stiffness=reversal_stiffness)
     if augmented == 2:     # multipliers updated inside the Newton iteration (nodal points)
@@ -66,16 +62,13 @@ def run(level: int, mu: float, k: float, width: float, predictor: str, quadratur
         enforcement = AugmentedLagrangian(tolerance=al_tol)
     else:
         enforcement = Penalty()
-    try:
-        m = flat_punch.build(comm, mesh_size=mesh_size, contact_size=contact_size, order=1,
-                             load_half_width=10.0, law=law, steps=N_LOAD,
-                             quadrature="gauss" if quadrature == "nodal" else quadrature,
-                             points="nodal" if quadrature == "nodal" else "quadrature",
-                             enforcement=enforcement,
-                             solver_options=dict(continuation=continuation,
-                                                 linear_solver=linear_solver))
-    finally:
-        flat_punch.NodalContactInterface = NodalContactInterface
+    m = flat_punch.build(comm, mesh_size=mesh_size, contact_size=contact_size, order=1,
+                         load_half_width=10.0, law=law, steps=N_LOAD,
+                         quadrature="gauss" if quadrature == "nodal" else quadrature,
+                         points="nodal" if quadrature == "nodal" else "quadrature",
+                         basis=basis, enforcement=enforcement,
+                         solver_options=dict(continuation=continuation,
+                                             linear_solver=linear_solver))
     factors = load_unload_factors(N_LOAD, N_LOAD - 1, final_factor=1.0 / N_LOAD)
     t0 = time.process_time()
     exact = (float("nan"), float("nan"))

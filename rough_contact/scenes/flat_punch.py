@@ -240,7 +240,7 @@ def build(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2, load_h
           dof_threshold=None, quadrature_degree=None, normal=None, seating_steps=None,
           cell_type="tetrahedron", *, punch_scene=None, total_force=TOTAL_FORCE,
           solver_defaults=None, quadrature="gauss", solver_options=None, enforcement=None,
-          kt_over_kn=None, pairing="auto", points="quadrature"):
+          kt_over_kn=None, pairing="auto", points="quadrature", basis="standard"):
     """Mesh, law, interface, problem and solver of the quarter punch. Collective.
 
     ``pairing`` pairs the punch bottom with the foundation (``ContactInterface(pairing=)``):
@@ -257,6 +257,11 @@ def build(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2, load_h
     ``points``: ``"quadrature"`` (the law at the rule's points) or ``"nodal"`` (at the
     first surface's vertices on mortar-weighted jumps, any order:
     :class:`rough_contact.fem.nodal.NodalContactInterface`).
+
+    ``basis`` (``points="nodal"`` only): the weights of the nodal set's vertex jumps,
+    ``"standard"`` (the vertex functions N_j, the default) or ``"dual"`` (their biorthogonal
+    basis: a vertex's jump uses its own DOFs, node to node on a conforming pairing;
+    ``NodalContactInterface(basis=)``, docs/exact_contact_newton.md).
 
     ``punch_scene`` reuses a :class:`PunchScene` of :func:`quarter_punch` (mesh sizes, order
     and cell type are then taken from it); ``total_force`` is the full punch's force at load
@@ -282,6 +287,7 @@ def build(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2, load_h
         raise ValueError(f"steps = {steps!r} is invalid: it must be an integer >= 1")
     if seating_steps is not None and (int(seating_steps) != seating_steps or seating_steps < 1):
         raise ValueError(f"seating_steps = {seating_steps!r} is invalid: it must be an integer >= 1")
+    _check_points_basis(points, basis)
     if punch_scene is None:
         punch_scene = quarter_punch(comm, mesh_size, contact_size, order, load_half_width,
                                     cell_type)
@@ -303,13 +309,13 @@ def build(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2, load_h
     qdeg = quadrature_degree if quadrature_degree is not None else default_qdeg(order)
     if isinstance(pairing, str) and pairing == "auto":   # non-matching: the patch-exact mortar
         pairing = AutoPairing(second, "mortar" if quadrature == "gauss" else None)
-    if points not in ("quadrature", "nodal"):
-        raise ValueError(f"points = {points!r} is invalid: 'quadrature' or 'nodal'")
-    kind = NodalContactInterface if points == "nodal" else ContactInterface
-    interface = kind(V, scene.facet_tags, first, second, law=interface_law,
-                                 grain_direction=GRAIN_X, quadrature_degree=qdeg,
-                                 quadrature=quadrature, bcs=bcs, enforcement=enforcement,
-                                 pairing=pairing)
+    common = dict(law=interface_law, grain_direction=GRAIN_X, quadrature_degree=qdeg,
+                  quadrature=quadrature, bcs=bcs, enforcement=enforcement, pairing=pairing)
+    if points == "nodal":
+        interface = NodalContactInterface(V, scene.facet_tags, first, second, basis=basis,
+                                          **common)
+    else:
+        interface = ContactInterface(V, scene.facet_tags, first, second, **common)
     materials = {scene.tag("punch"): Material(E, NU), scene.tag("foundation"): Material(E, NU)}
     loads = [SurfaceLoad(scene.tag("load"), force=[0.0, 0.0, -quarter_force])]
     problem = ContactProblem(V, materials, bcs, loads, cell_tags=scene.cell_tags,
@@ -320,6 +326,20 @@ def build(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2, load_h
                         defaults=solver_defaults, **(solver_options or {}))
     return PunchModel(scene=scene, V=V, law=interface_law, normal=normal, interface=interface,
                       problem=problem, solver=solver, quarter_force=quarter_force)
+
+
+def _check_points_basis(points, basis):
+    """The interface points and the nodal set's basis: refused with the valid values (the
+    same check on every rank, before any collective call)."""
+    if points not in ("quadrature", "nodal"):
+        raise ValueError(f"points = {points!r} is invalid: 'quadrature' or 'nodal'")
+    if basis not in ("standard", "dual"):
+        raise ValueError(f"basis = {basis!r} is invalid: 'standard' (the vertex functions) "
+                         "or 'dual' (their biorthogonal basis)")
+    if basis != "standard" and points != "nodal":
+        raise ValueError(f"basis = {basis!r} is invalid with points = {points!r}: the basis "
+                         "weighs the nodal set's vertex jumps, use points='nodal' (or "
+                         "basis='standard')")
 
 
 # ## Output helpers

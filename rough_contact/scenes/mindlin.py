@@ -134,7 +134,8 @@ def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5
         shear_steps=12, cycles=0, indenter="paraboloid", quadrature_degree=None,
         k_tangential=None, ring_size=None, ring_band=(0.8, 1.05), width_ratio=1e-3,
         augmented=False, augmentation_tolerance=1e-3, points="quadrature",
-        max_updates=30, comm=MPI.COMM_WORLD, verbose=False) -> MindlinRun:
+        max_updates=30, basis="standard", comm=MPI.COMM_WORLD,
+        verbose=False) -> MindlinRun:
     """Normal indentation by ``delta`` [mm], then a tangential bottom displacement: monotonic to
     ``slide`` [mm] (``cycles`` = 0) or ``cycles`` triangle cycles of amplitude ``slide``.
 
@@ -169,6 +170,9 @@ def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5
     vertices of the contact surface on mortar-weighted jumps,
     :class:`rough_contact.fem.nodal.NodalContactInterface`: one constraint per surface vertex,
     so exact stick does not lock on P2). ``max_updates``: multiplier updates per increment.
+    ``basis`` (``points="nodal"`` only): the weights of the vertex jumps, ``"standard"`` (the
+    vertex functions) or ``"dual"`` (their biorthogonal basis;
+    ``NodalContactInterface(basis=)``).
 
     ``slide`` defaults to the approach at which Mindlin's Q reaches mu P for Hertz's P at
     ``delta`` plus the block's shear compliance (so the last increments slide).
@@ -180,6 +184,15 @@ def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5
     """
     check_scalar("delta", delta, lo=0.0, unit="mm")
     check_scalar("mu", mu, lo=0.0)
+    if points not in ("quadrature", "nodal"):
+        raise ValueError(f"points = {points!r} is invalid: 'quadrature' or 'nodal'")
+    if basis not in ("standard", "dual"):
+        raise ValueError(f"basis = {basis!r} is invalid: 'standard' (the vertex functions) "
+                         "or 'dual' (their biorthogonal basis)")
+    if basis != "standard" and points != "nodal":
+        raise ValueError(f"basis = {basis!r} is invalid with points = {points!r}: the basis "
+                         "weighs the nodal set's vertex jumps, use points='nodal' (or "
+                         "basis='standard')")
     if cycles and shear_steps % 4:
         raise ValueError(f"shear_steps = {shear_steps} is invalid for cycles: it must be a "
                          "multiple of 4")
@@ -211,18 +224,18 @@ def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5
     law = SoftplusPenalty(penalty, width_ratio * delta, k_tangential=k_tangential, friction=mu)
     enforcement = AugmentedLagrangian(augmentation_tolerance, max_updates) if augmented \
         else Penalty()
-    if points not in ("quadrature", "nodal"):
-        raise ValueError(f"points = {points!r} is invalid: 'quadrature' or 'nodal'")
     if indenter not in ("paraboloid", "sphere"):
         raise ValueError(f"indenter = {indenter!r} is invalid: 'paraboloid' or 'sphere'")
     rigid = ParaboloidIndenter(radius) if indenter == "paraboloid" else \
         RigidSphere((0.0, 0.0, radius), radius)
-    ci = (NodalContactInterface if points == "nodal" else ContactInterface)(
-                          V, scene.facet_tags, scene.tag("contact"), law=law,
-                          rigid=rigid, bcs=[sym],
-                          quadrature_degree=default_qdeg(order) if quadrature_degree is None
-                          else quadrature_degree, grain_direction=GRAIN_X,
-                          enforcement=enforcement)
+    common = dict(law=law, rigid=rigid, bcs=[sym], grain_direction=GRAIN_X,
+                  quadrature_degree=default_qdeg(order) if quadrature_degree is None
+                  else quadrature_degree, enforcement=enforcement)
+    if points == "nodal":
+        ci = NodalContactInterface(V, scene.facet_tags, scene.tag("contact"), basis=basis,
+                                   **common)
+    else:
+        ci = ContactInterface(V, scene.facet_tags, scene.tag("contact"), **common)
     bottom = scene.tag("bottom")
     prog = _program(preload_steps, shear_steps, cycles)
     problem = ContactProblem(

@@ -7,6 +7,9 @@ docs/exact_contact_newton.md: experimental, not faster than Uzawa's route on the
   would leave k |g| ~ p without the multiplier updates: checked on the gap), no shear, no
   slip; the multipliers were updated inside the Newton iteration; serial = 2 ranks to 1e-10.
 * Bad arguments are refused with the quantity, its value and the valid range.
+* The scenes' ``basis`` argument (flat punch, Mindlin) reaches the nodal interface: on the
+  punch's conforming P1 pairing the dual basis couples a vertex to its partner alone (two
+  nodes per row), the standard one to its facet patch; bad values are refused.
 
 Run serial and in parallel:
     .venv/bin/python -m pytest tests/fem/test_nodal_ssn.py
@@ -119,19 +122,15 @@ def _punch(enforcement, comm=MPI.COMM_WORLD, basis="standard"):
     """GetFEM's flat punch on a coarse mesh, P1, Coulomb mu = 0.2, 4 loading and 3
     unloading increments: dissipation per increment, vertex tractions at the end, exactness
     at the peak (largest k_T |s - s_p| over the sticking vertices / largest traction)."""
-    import functools
     from rough_contact.scenes import flat_punch
     from rough_contact.solver.loading import load_unload_factors
     k = 1e7
     law = SoftplusPenalty(k_normal=k, width=2.5e-9, k_tangential=k, friction=0.2)
-    flat_punch.NodalContactInterface = functools.partial(NodalContactInterface, basis=basis)
-    try:     # the scene has no argument for the basis: its interface class with it bound
-        m = flat_punch.build(comm, mesh_size=20.0, contact_size=2.0, order=1,
-                             load_half_width=10.0, law=law, steps=4, points="nodal",
-                             enforcement=enforcement, prefix="test_ssn_punch_",
-                             solver_options=dict(linear_solver="mumps"))
-    finally:
-        flat_punch.NodalContactInterface = NodalContactInterface
+    m = flat_punch.build(comm, mesh_size=20.0, contact_size=2.0, order=1,
+                         load_half_width=10.0, law=law, steps=4, points="nodal", basis=basis,
+                         enforcement=enforcement, prefix="test_ssn_punch_",
+                         solver_options=dict(linear_solver="mumps"))
+    assert m.interface.basis == basis
     D, stick_err = [], None
     for inc in load_path(m.problem, m.solver, load_unload_factors(4, 3, final_factor=0.25)):
         D.append(inc.dissipation)
@@ -181,3 +180,42 @@ def test_punch_rank_independent(punch_newton):
                          MPI.COMM_SELF, basis)
     np.testing.assert_allclose(D, D_s, rtol=1e-10, atol=1e-14)
     np.testing.assert_allclose(t, t_s, rtol=0, atol=1e-10 * np.abs(t_s).max())
+
+
+def _row_width(interface, comm):
+    """Largest number of nodes in a vertex's weighted jump, over all ranks."""
+    n = interface.nodal.B.shape[2] // 3 if interface.n_points else 0
+    return comm.allreduce(n, op=MPI.MAX)
+
+
+def test_scene_basis_reaches_interface():
+    """flat_punch.build(basis=) builds the nodal interface on that basis: dual = node to node
+    on the conforming pairing (2 nodes per row, as the vertex rule), standard = the facet
+    patch on both sides (more)."""
+    from rough_contact.scenes import flat_punch
+    law = SoftplusPenalty(k_normal=1e7, width=2.5e-9, k_tangential=1e7, friction=0.2)
+    comm = MPI.COMM_WORLD
+    widths = {}
+    for basis in ("standard", "dual"):
+        m = flat_punch.build(comm, mesh_size=20.0, contact_size=2.0, order=1,
+                             load_half_width=10.0, law=law, steps=4, points="nodal",
+                             basis=basis, prefix="test_ssn_basis_")
+        assert isinstance(m.interface, NodalContactInterface)
+        assert m.interface.basis == basis
+        widths[basis] = _row_width(m.interface, comm)
+        m.solver.destroy()
+    assert widths["dual"] == 2
+    assert widths["standard"] > 2
+
+
+@pytest.mark.parametrize("kwargs,match", [
+    (dict(points="nodal", basis="biorthogonal"), "basis = 'biorthogonal' is invalid"),
+    (dict(points="quadrature", basis="dual"), "basis = 'dual' is invalid with points"),
+    (dict(points="vertex"), "points = 'vertex' is invalid")])
+def test_scene_bad_basis(kwargs, match):
+    """Refused before any mesh is built, naming the quantity, its value and the choices."""
+    from rough_contact.scenes import flat_punch, mindlin
+    with pytest.raises(ValueError, match=match):
+        flat_punch.build(MPI.COMM_WORLD, law="penalty", **kwargs)
+    with pytest.raises(ValueError, match=match):
+        mindlin.run(**kwargs)
