@@ -71,8 +71,9 @@ def _run(comm, sliding, path, friction=MU, normal="pressure", scene_kw=None, pre
     """The slider pressed (2 increments), then its top driven along x through ``path``
     [(load factor, x displacement)]. ``normal``: "pressure" (P_TOP on the top) or a prescribed
     z displacement of the top [mm] (a float)."""
-    scene = _scene(comm, **(scene_kw or {}))
-    V = compat.vector_space(scene.mesh, 1)
+    scene_kw = scene_kw or {}
+    scene = _scene(comm, **scene_kw)
+    V = compat.vector_space(scene.mesh, scene_kw.get("order", 1))   # the geometry's degree
 
     def roller(name):
         dofs = fem.locate_dofs_topological(V.sub(1), 2, scene.facet_tags.find(scene.tag(name)))
