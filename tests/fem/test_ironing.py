@@ -40,11 +40,12 @@ H, TOL = 0.0625, 1e-7            # element size [mm], sliding tolerance [-]
 _SCENES = {}
 
 
-def _scene(comm):
-    if comm.size not in _SCENES:
-        _SCENES[comm.size] = block_on_plane(lx=1.75, ly=0.25, h=0.25, mesh_size=H,
-                                            cell_type="hexahedron", comm=comm)
-    return _SCENES[comm.size]
+def _scene(comm, order=1, cell_type="hexahedron", h=H):
+    key = (comm.size, order, cell_type, h)
+    if key not in _SCENES:
+        _SCENES[key] = block_on_plane(lx=1.75, ly=0.25, h=0.25, mesh_size=h, order=order,
+                                      cell_type=cell_type, comm=comm)
+    return _SCENES[key]
 
 
 def _ramp(t):
@@ -64,9 +65,9 @@ def test_normal_energy_closed_form():
         assert _psi_normal(g) == pytest.approx(ref, rel=1e-9)
 
 
-def _iron(comm, shape, depth, n_iron=10):
-    scene = _scene(comm)
-    V = compat.vector_space(scene.mesh, 1)
+def _iron(comm, shape, depth, n_iron=10, order=1, cell_type="hexahedron", h=H):
+    scene = _scene(comm, order, cell_type, h)
+    V = compat.vector_space(scene.mesh, order)
     bcs = [fix(V, scene.facet_tags, scene.tag("top")),
            fix(V, scene.facet_tags, scene.tag("y0"), 1)]
     # the indenter below the slab (contact face z = 0), touching it at (X0, 0, 0)

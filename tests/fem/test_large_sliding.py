@@ -42,7 +42,7 @@ _SCENES = {}
 def _scene(comm, **kw):
     key = (comm.size, tuple(sorted(kw.items())))
     if key not in _SCENES:
-        _SCENES[key] = slider_on_slab(comm=comm, size_slab=H_SLAB, **kw)
+        _SCENES[key] = slider_on_slab(comm=comm, **{"size_slab": H_SLAB, **kw})
     return _SCENES[key]
 
 
@@ -134,12 +134,23 @@ BACK = [(2.5 + 0.2 * (j + 1), SLIDE * (1 - (j + 1) / 5)) for j in range(5)]
 HOLD2 = [(4.0, 0.0)]
 
 
-def _block_slide(comm):
-    return _run(comm, "large", FORWARD + HOLD1 + BACK + HOLD2, scene_kw=dict(slab_length=4.0))
+# the same slide on P2 and on tetrahedra, on a coarse mesh (slab and slider 0.25 mm high,
+# elements of 0.25 mm: the slide is 5 of the slab's elements) so that each case takes seconds
+COARSE = dict(size_slab=0.25, size_slider=0.25, h_slab=0.25, h_slider=0.25)
+ELEMENTS = {"Q1 hexahedra": {},
+            "Q2 hexahedra": dict(order=2, **COARSE),
+            "P1 tetrahedra": dict(cell_type="tetrahedron", **COARSE),
+            "P2 tetrahedra": dict(order=2, cell_type="tetrahedron", **COARSE)}
 
 
-def test_block_slid_and_back_transmits_mu_n_and_keeps_it_on_a_hold():
-    r = _block_slide(MPI.COMM_WORLD)
+def _block_slide(comm, element="Q1 hexahedra"):
+    return _run(comm, "large", FORWARD + HOLD1 + BACK + HOLD2,
+                scene_kw=dict(slab_length=4.0, **ELEMENTS[element]))
+
+
+@pytest.mark.parametrize("element", list(ELEMENTS))
+def test_block_slid_and_back_transmits_mu_n_and_keeps_it_on_a_hold(element):
+    r = _block_slide(MPI.COMM_WORLD, element)
     incs, F = r["incs"], _forces(r)
     n_pts = incs[0].n_points
     gross = [i for i, inc in enumerate(incs) if inc.n_slipping == n_pts]
@@ -155,7 +166,7 @@ def test_block_slid_and_back_transmits_mu_n_and_keeps_it_on_a_hold():
         assert np.abs(F[hold] - F[hold - 1]).max() <= 1e-8 * MU * abs(F[hold - 1, 2])
         assert abs(abs(F[hold, 0]) - MU * abs(F[hold, 2])) <= 1e-8 * MU * abs(F[hold, 2])
     assert r["ci"].n_repairs >= 10                  # the partners changed along the way
-    _same_on_one_rank(r, _block_slide)
+    _same_on_one_rank(r, lambda comm: _block_slide(comm, element))
 
 
 def test_moderate_sliding_drops_on_a_hold():
