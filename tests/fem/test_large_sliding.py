@@ -199,10 +199,11 @@ def test_large_sliding_does_not_lag():
 
 # off the edge: on Q2 the coarse mesh's normal force depends on where the slider's edges sit
 # on the slab's elements by more than the slide changes it while the slider is still fully on
-# the slab (+0.14 % at 0.4 mm, docs/sliding_p2.md), so Q2 slides on 0.125 mm elements
+# the slab (+0.14 % at 0.4 mm, docs/sliding_p2.md), so Q2 slides on 0.125 mm elements (a
+# narrower scene, 0.25 mm wide, to stay fast)
 EDGE_ELEMENTS = {"Q1 hexahedra": {},
                  "Q2 hexahedra": dict(order=2, size_slab=0.125, size_slider=0.125,
-                                      h_slab=0.25, h_slider=0.25),
+                                      h_slab=0.25, h_slider=0.25, width=0.25),
                  "P1 tetrahedra": ELEMENTS["P1 tetrahedra"],
                  "P2 tetrahedra": ELEMENTS["P2 tetrahedra"]}
 
