@@ -251,6 +251,8 @@ def test_sliding_options_refuse_bad_input():
     law = SoftplusPenalty(1e6, 1e-5)
     first, second = scene.contact_pair
     sphere = RigidSphere((0.0, 0.0, -10.0), 10.0)
+    with pytest.raises(ValueError, match="cell_type = 'prism' is invalid; valid values"):
+        slider_on_slab(cell_type="prism", comm=MPI.COMM_WORLD)
     with pytest.raises(ValueError, match="sliding_tolerance = 0.0 is invalid: it must be finite and > 0"):
         ContactInterface(V, scene.facet_tags, first, second, law=law, sliding="large",
                          sliding_tolerance=0.0)
