@@ -40,11 +40,12 @@ H, TOL = 0.0625, 1e-7            # element size [mm], sliding tolerance [-]
 _SCENES = {}
 
 
-def _scene(comm):
-    if comm.size not in _SCENES:
-        _SCENES[comm.size] = block_on_plane(lx=1.75, ly=0.25, h=0.25, mesh_size=H,
-                                            cell_type="hexahedron", comm=comm)
-    return _SCENES[comm.size]
+def _scene(comm, order=1, cell_type="hexahedron", h=H):
+    key = (comm.size, order, cell_type, h)
+    if key not in _SCENES:
+        _SCENES[key] = block_on_plane(lx=1.75, ly=0.25, h=0.25, mesh_size=h, order=order,
+                                      cell_type=cell_type, comm=comm)
+    return _SCENES[key]
 
 
 def _ramp(t):
@@ -64,9 +65,9 @@ def test_normal_energy_closed_form():
         assert _psi_normal(g) == pytest.approx(ref, rel=1e-9)
 
 
-def _iron(comm, shape, depth, n_iron=10):
-    scene = _scene(comm)
-    V = compat.vector_space(scene.mesh, 1)
+def _iron(comm, shape, depth, n_iron=10, order=1, cell_type="hexahedron", h=H):
+    scene = _scene(comm, order, cell_type, h)
+    V = compat.vector_space(scene.mesh, order)
     bcs = [fix(V, scene.facet_tags, scene.tag("top")),
            fix(V, scene.facet_tags, scene.tag("y0"), 1)]
     # the indenter below the slab (contact face z = 0), touching it at (X0, 0, 0)
@@ -122,9 +123,16 @@ def _iron(comm, shape, depth, n_iron=10):
     return out
 
 
-@pytest.mark.parametrize("shape, depth", [("sphere", 0.02), ("cylinder", 0.02)])
-def test_ironing_rigid_indenter(shape, depth):
-    r = _iron(MPI.COMM_WORLD, shape, depth)
+# P1 hexahedra. On Q2 hexahedra and on tetrahedra of a size that keeps the test fast the force
+# ripple of the patch crossing the elements reaches 1 % (docs/sliding_p2.md, with figures): the
+# tetrahedra pass on one gmsh version's mesh and fail on the other's, so they are not here
+CASES = [("sphere", 1, "hexahedron", H), ("cylinder", 1, "hexahedron", H)]
+
+
+@pytest.mark.parametrize("shape, order, cell_type, h", CASES)
+def test_ironing_rigid_indenter(shape, order, cell_type, h):
+    depth = 0.02
+    r = _iron(MPI.COMM_WORLD, shape, depth, order=order, cell_type=cell_type, h=h)
     F = r["F"]
     ironing = F[6:]
     # in contact and dragged: the slab pushed up, the friction force against the motion
@@ -135,11 +143,11 @@ def test_ironing_rigid_indenter(shape, depth):
     for k in (0, 2):
         assert np.abs(np.diff(steady[:, k])).max() <= 0.01 * np.abs(steady[:, k]).mean()
     # the gap is the current distance to the moved indenter (to the sliding tolerance)
-    assert r["gap_err"].max() <= TOL * H
+    assert r["gap_err"].max() <= TOL * h
     # energy balance: work in = stored + dissipated, within 1 % of the work
     balance = r["work"] - r["stored"] - r["dissipated"]
     assert np.abs(balance).max() <= 0.01 * r["work"][-1]
     assert r["dissipated"][-1] > 0.2 * r["work"][-1]     # a real ironing: mostly friction
     if MPI.COMM_WORLD.size > 1:
-        serial = _iron(MPI.COMM_SELF, shape, depth)
+        serial = _iron(MPI.COMM_SELF, shape, depth, order=order, cell_type=cell_type, h=h)
         np.testing.assert_allclose(F, serial["F"], rtol=0, atol=1e-10 * np.abs(F).max())

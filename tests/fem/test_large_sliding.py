@@ -42,7 +42,7 @@ _SCENES = {}
 def _scene(comm, **kw):
     key = (comm.size, tuple(sorted(kw.items())))
     if key not in _SCENES:
-        _SCENES[key] = slider_on_slab(comm=comm, size_slab=H_SLAB, **kw)
+        _SCENES[key] = slider_on_slab(comm=comm, **{"size_slab": H_SLAB, **kw})
     return _SCENES[key]
 
 
@@ -71,8 +71,9 @@ def _run(comm, sliding, path, friction=MU, normal="pressure", scene_kw=None, pre
     """The slider pressed (2 increments), then its top driven along x through ``path``
     [(load factor, x displacement)]. ``normal``: "pressure" (P_TOP on the top) or a prescribed
     z displacement of the top [mm] (a float)."""
-    scene = _scene(comm, **(scene_kw or {}))
-    V = compat.vector_space(scene.mesh, 1)
+    scene_kw = scene_kw or {}
+    scene = _scene(comm, **scene_kw)
+    V = compat.vector_space(scene.mesh, scene_kw.get("order", 1))   # the geometry's degree
 
     def roller(name):
         dofs = fem.locate_dofs_topological(V.sub(1), 2, scene.facet_tags.find(scene.tag(name)))
@@ -133,12 +134,23 @@ BACK = [(2.5 + 0.2 * (j + 1), SLIDE * (1 - (j + 1) / 5)) for j in range(5)]
 HOLD2 = [(4.0, 0.0)]
 
 
-def _block_slide(comm):
-    return _run(comm, "large", FORWARD + HOLD1 + BACK + HOLD2, scene_kw=dict(slab_length=4.0))
+# the same slide on P2 and on tetrahedra, on a coarse mesh (slab and slider 0.25 mm high,
+# elements of 0.25 mm: the slide is 5 of the slab's elements) so that each case takes seconds
+COARSE = dict(size_slab=0.25, size_slider=0.25, h_slab=0.25, h_slider=0.25)
+ELEMENTS = {"Q1 hexahedra": {},
+            "Q2 hexahedra": dict(order=2, **COARSE),
+            "P1 tetrahedra": dict(cell_type="tetrahedron", **COARSE),
+            "P2 tetrahedra": dict(order=2, cell_type="tetrahedron", **COARSE)}
 
 
-def test_block_slid_and_back_transmits_mu_n_and_keeps_it_on_a_hold():
-    r = _block_slide(MPI.COMM_WORLD)
+def _block_slide(comm, element="Q1 hexahedra"):
+    return _run(comm, "large", FORWARD + HOLD1 + BACK + HOLD2,
+                scene_kw=dict(slab_length=4.0, **ELEMENTS[element]))
+
+
+@pytest.mark.parametrize("element", list(ELEMENTS))
+def test_block_slid_and_back_transmits_mu_n_and_keeps_it_on_a_hold(element):
+    r = _block_slide(MPI.COMM_WORLD, element)
     incs, F = r["incs"], _forces(r)
     n_pts = incs[0].n_points
     gross = [i for i, inc in enumerate(incs) if inc.n_slipping == n_pts]
@@ -154,7 +166,7 @@ def test_block_slid_and_back_transmits_mu_n_and_keeps_it_on_a_hold():
         assert np.abs(F[hold] - F[hold - 1]).max() <= 1e-8 * MU * abs(F[hold - 1, 2])
         assert abs(abs(F[hold, 0]) - MU * abs(F[hold, 2])) <= 1e-8 * MU * abs(F[hold, 2])
     assert r["ci"].n_repairs >= 10                  # the partners changed along the way
-    _same_on_one_rank(r, _block_slide)
+    _same_on_one_rank(r, lambda comm: _block_slide(comm, element))
 
 
 def test_moderate_sliding_drops_on_a_hold():
@@ -185,14 +197,27 @@ def test_large_sliding_does_not_lag():
     assert abs(lagging["x_load"] - 5 * H_SLAB) > 0.5 * 5 * H_SLAB
 
 
-def _slide_off(comm):
+# off the edge: on Q2 the coarse mesh's normal force depends on where the slider's edges sit
+# on the slab's elements by more than the slide changes it while the slider is still fully on
+# the slab (+0.14 % at 0.4 mm, docs/sliding_p2.md), so Q2 slides on 0.125 mm elements (a
+# narrower scene, 0.25 mm wide, to stay fast)
+EDGE_ELEMENTS = {"Q1 hexahedra": {},
+                 "Q2 hexahedra": dict(order=2, size_slab=0.125, size_slider=0.125,
+                                      h_slab=0.25, h_slider=0.25, width=0.25),
+                 "P1 tetrahedra": ELEMENTS["P1 tetrahedra"],
+                 "P2 tetrahedra": ELEMENTS["P2 tetrahedra"]}
+
+
+def _slide_off(comm, element="Q1 hexahedra"):
     # slab 2 mm long (|x| <= 1), slider 1 mm: fully off the slab at 1.5 mm
     path = [(1.0 + 0.1 * (j + 1), 0.2 * (j + 1)) for j in range(8)]
-    return _run(comm, "large", path, normal=2e-3, scene_kw=dict(slab_length=2.0))
+    return _run(comm, "large", path, normal=2e-3,
+                scene_kw=dict(slab_length=2.0, **EDGE_ELEMENTS[element]))
 
 
-def test_body_sliding_off_the_edge_loses_contact_smoothly():
-    r = _slide_off(MPI.COMM_WORLD)
+@pytest.mark.parametrize("element", list(EDGE_ELEMENTS))
+def test_body_sliding_off_the_edge_loses_contact_smoothly(element):
+    r = _slide_off(MPI.COMM_WORLD, element)
     ci, incs = r["ci"], r["incs"]
     assert len(incs) == 10 and all(inc.cutbacks == 0 for inc in incs)
     fz = _forces(r)[:, 2]
@@ -200,7 +225,7 @@ def test_body_sliding_off_the_edge_loses_contact_smoothly():
     assert fz[-1] == 0.0 and r["active"][-1] == 0                     # all off: no contact
     # in between, the active points are exactly those over the slab
     assert 0 < r["active"][5] < r["active"][1] == incs[0].n_points
-    _same_on_one_rank(r, _slide_off)
+    _same_on_one_rank(r, lambda comm: _slide_off(comm, element))
 
 
 def test_points_off_the_slab_are_inactive_by_geometry():
@@ -226,6 +251,8 @@ def test_sliding_options_refuse_bad_input():
     law = SoftplusPenalty(1e6, 1e-5)
     first, second = scene.contact_pair
     sphere = RigidSphere((0.0, 0.0, -10.0), 10.0)
+    with pytest.raises(ValueError, match="cell_type = 'prism' is invalid; valid values"):
+        slider_on_slab(cell_type="prism", comm=MPI.COMM_WORLD)
     with pytest.raises(ValueError, match="sliding_tolerance = 0.0 is invalid: it must be finite and > 0"):
         ContactInterface(V, scene.facet_tags, first, second, law=law, sliding="large",
                          sliding_tolerance=0.0)

@@ -193,10 +193,12 @@ def separate_blocks(lx: float = 1.0, ly: float = 1.0, h1: float = 1.0, h2: float
 def slider_on_slab(slab_length: float = 3.0, slider_length: float = 1.0, width: float = 0.5,
                    h_slab: float = 0.5, h_slider: float = 0.5, size_slab: float = 0.125,
                    size_slider: float = 0.1, order: int = 1,
+                   cell_type: str = "hexahedron",
                    comm: MPI.Comm = MPI.COMM_WORLD) -> Scene:
-    """A short block (the slider) on a long one (the slab), meshed independently with
-    structured hexahedra, both centred on x = 0, y in [0, width]: the scene of a body sliding
-    over several elements of the other (moderate sliding). Collective.
+    """A short block (the slider) on a long one (the slab), meshed independently (structured
+    hexahedra, or unstructured tetrahedra of the given target sizes), both centred on x = 0,
+    y in [0, width]: the scene of a body sliding over several elements of the other.
+    Collective. ``order``: 1 or 2; ``cell_type``: ``"hexahedron"`` or ``"tetrahedron"``.
 
     Groups: bodies ``slider`` (1), ``slab`` (2); ``contact_slider`` (11, first),
     ``contact_slab`` (12), ``top`` (13, slider top), ``bottom`` (14, slab bottom),
@@ -206,6 +208,7 @@ def slider_on_slab(slab_length: float = 3.0, slider_length: float = 1.0, width: 
                       h_slab=h_slab, h_slider=h_slider, size_slab=size_slab,
                       size_slider=size_slider)
     validate_order(order)
+    validate_cell_type(cell_type)
     if slider_length >= slab_length:
         raise ValueError(f"slider_length = {slider_length} must be < slab_length = "
                          f"{slab_length}")
@@ -231,7 +234,15 @@ def slider_on_slab(slab_length: float = 3.0, slider_length: float = 1.0, width: 
             "bottom": (14, pick(slab, np.abs(z + h_slab) < tol)),
             "y0_slider": (15, pick(slider, np.abs(y) < tol)),
             "y0_slab": (16, pick(slab, np.abs(y) < tol))})
-        _separate_hexahedra(model, faces, ((slab, size_slab), (slider, size_slider)))
+        sizes = ((slab, size_slab), (slider, size_slider))
+        if cell_type == "hexahedron":
+            _separate_hexahedra(model, faces, sizes)
+        else:
+            import gmsh
+
+            for vol, size in sizes:
+                model.mesh.setSize(model.getBoundary([(3, vol)], recursive=True), size)
+            gmsh.option.setNumber("Mesh.MeshSizeMax", max(size_slab, size_slider))
         generate(model, order)
 
     return build_contact_scene(
