@@ -40,7 +40,7 @@ from rough_contact.references import effective_modulus
 from rough_contact.scenes.defaults import GRAIN_X, SEATING_STIFFNESS
 from rough_contact.scenes.defaults import quadrature_degree as default_qdeg
 from rough_contact.scenes.meshes.flat_punch import flat_punch
-from rough_contact.scenes.setup import check_mesh_arguments
+from rough_contact.scenes.setup import check_mesh_arguments, check_points_basis
 from rough_contact.solver.loading import load_path, load_unload_factors
 from rough_contact.solver.snes import SNESSolver
 from rough_contact.validation import check_scalar
@@ -287,7 +287,7 @@ def build(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2, load_h
         raise ValueError(f"steps = {steps!r} is invalid: it must be an integer >= 1")
     if seating_steps is not None and (int(seating_steps) != seating_steps or seating_steps < 1):
         raise ValueError(f"seating_steps = {seating_steps!r} is invalid: it must be an integer >= 1")
-    _check_points_basis(points, basis)
+    check_points_basis(points, basis)
     if punch_scene is None:
         punch_scene = quarter_punch(comm, mesh_size, contact_size, order, load_half_width,
                                     cell_type)
@@ -326,20 +326,6 @@ def build(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2, load_h
                         defaults=solver_defaults, **(solver_options or {}))
     return PunchModel(scene=scene, V=V, law=interface_law, normal=normal, interface=interface,
                       problem=problem, solver=solver, quarter_force=quarter_force)
-
-
-def _check_points_basis(points, basis):
-    """The interface points and the nodal set's basis: refused with the valid values (the
-    same check on every rank, before any collective call)."""
-    if points not in ("quadrature", "nodal"):
-        raise ValueError(f"points = {points!r} is invalid: 'quadrature' or 'nodal'")
-    if basis not in ("standard", "dual"):
-        raise ValueError(f"basis = {basis!r} is invalid: 'standard' (the vertex functions) "
-                         "or 'dual' (their biorthogonal basis)")
-    if basis != "standard" and points != "nodal":
-        raise ValueError(f"basis = {basis!r} is invalid with points = {points!r}: the basis "
-                         "weighs the nodal set's vertex jumps, use points='nodal' (or "
-                         "basis='standard')")
 
 
 # ## Output helpers

@@ -38,6 +38,7 @@ from rough_contact.references import hertz_force, hertz_radius, sliding_approach
 from rough_contact.scenes.defaults import GRAIN_X, INDENTER_PENALTY
 from rough_contact.scenes.defaults import quadrature_degree as default_qdeg
 from rough_contact.scenes.meshes.blocks import indented_block
+from rough_contact.scenes.setup import check_points_basis
 from rough_contact.solver.loading import load_path
 from rough_contact.solver.program import LoadProgram
 from rough_contact.solver.snes import SNESSolver
@@ -184,15 +185,7 @@ def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5
     """
     check_scalar("delta", delta, lo=0.0, unit="mm")
     check_scalar("mu", mu, lo=0.0)
-    if points not in ("quadrature", "nodal"):
-        raise ValueError(f"points = {points!r} is invalid: 'quadrature' or 'nodal'")
-    if basis not in ("standard", "dual"):
-        raise ValueError(f"basis = {basis!r} is invalid: 'standard' (the vertex functions) "
-                         "or 'dual' (their biorthogonal basis)")
-    if basis != "standard" and points != "nodal":
-        raise ValueError(f"basis = {basis!r} is invalid with points = {points!r}: the basis "
-                         "weighs the nodal set's vertex jumps, use points='nodal' (or "
-                         "basis='standard')")
+    check_points_basis(points, basis)
     if cycles and shear_steps % 4:
         raise ValueError(f"shear_steps = {shear_steps} is invalid for cycles: it must be a "
                          "multiple of 4")

@@ -17,7 +17,7 @@ from rough_contact.fem.problem import ContactProblem, PrescribedDisplacement, Su
 from rough_contact.scenes.defaults import SEATING_STIFFNESS
 from rough_contact.validation import check_scalar
 
-__all__ = ["check_mesh_arguments", "clamped_pair", "preload_then_drive"]
+__all__ = ["check_mesh_arguments", "check_points_basis", "clamped_pair", "preload_then_drive"]
 
 
 def check_mesh_arguments(order, **sizes) -> None:
@@ -55,3 +55,17 @@ def preload_then_drive(scene, V, material, clamp, interface, top: int, force: fl
         seating_stiffness=SEATING_STIFFNESS,
         prescribed=[PrescribedDisplacement(top, (drive, 0.0, 0.0), (0,), channel=channel)],
         programs=programs)
+
+
+def check_points_basis(points, basis):
+    """The interface points and the nodal set's basis: refused with the valid values (the
+    same check on every rank, before any collective call)."""
+    if points not in ("quadrature", "nodal"):
+        raise ValueError(f"points = {points!r} is invalid: 'quadrature' or 'nodal'")
+    if basis not in ("standard", "dual"):
+        raise ValueError(f"basis = {basis!r} is invalid: 'standard' (the vertex functions) "
+                         "or 'dual' (their biorthogonal basis)")
+    if basis != "standard" and points != "nodal":
+        raise ValueError(f"basis = {basis!r} is invalid with points = {points!r}: the basis "
+                         "weighs the nodal set's vertex jumps, use points='nodal' (or "
+                         "basis='standard')")
