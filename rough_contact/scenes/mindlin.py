@@ -135,7 +135,7 @@ def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5
         shear_steps=12, cycles=0, indenter="paraboloid", quadrature_degree=None,
         k_tangential=None, ring_size=None, ring_band=(0.8, 1.05), width_ratio=1e-3,
         augmented=False, augmentation_tolerance=1e-3, points="quadrature",
-        max_updates=30, basis="standard", comm=MPI.COMM_WORLD,
+        max_updates=30, basis="standard", enforcement=None, comm=MPI.COMM_WORLD,
         verbose=False) -> MindlinRun:
     """Normal indentation by ``delta`` [mm], then a tangential bottom displacement: monotonic to
     ``slide`` [mm] (``cycles`` = 0) or ``cycles`` triangle cycles of amplitude ``slide``.
@@ -175,6 +175,11 @@ def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5
     vertex functions) or ``"dual"`` (their biorthogonal basis;
     ``NodalContactInterface(basis=)``).
 
+    ``enforcement``: an enforcement of :mod:`rough_contact.interface.enforcement` used as
+    given (e.g. ``NewtonAugmentedLagrangian(1e-4)``, the multipliers updated inside the
+    Newton iteration, nodal points only); default ``None``: chosen by ``augmented``. Giving
+    both ``enforcement`` and ``augmented=True`` is an error.
+
     ``slide`` defaults to the approach at which Mindlin's Q reaches mu P for Hertz's P at
     ``delta`` plus the block's shear compliance (so the last increments slide).
 
@@ -186,6 +191,9 @@ def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5
     check_scalar("delta", delta, lo=0.0, unit="mm")
     check_scalar("mu", mu, lo=0.0)
     check_points_basis(points, basis)
+    if enforcement is not None and augmented:
+        raise ValueError(f"enforcement = {enforcement!r} with augmented = True is invalid: "
+                         "give one of them (augmented=True means AugmentedLagrangian)")
     if cycles and shear_steps % 4:
         raise ValueError(f"shear_steps = {shear_steps} is invalid for cycles: it must be a "
                          "multiple of 4")
@@ -215,8 +223,9 @@ def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5
     check_scalar("k_tangential", k_tangential, lo=0.0, unit="MPa/mm")
     check_scalar("width_ratio", width_ratio, lo=0.0)
     law = SoftplusPenalty(penalty, width_ratio * delta, k_tangential=k_tangential, friction=mu)
-    enforcement = AugmentedLagrangian(augmentation_tolerance, max_updates) if augmented \
-        else Penalty()
+    if enforcement is None:
+        enforcement = AugmentedLagrangian(augmentation_tolerance, max_updates) if augmented \
+            else Penalty()
     if indenter not in ("paraboloid", "sphere"):
         raise ValueError(f"indenter = {indenter!r} is invalid: 'paraboloid' or 'sphere'")
     rigid = ParaboloidIndenter(radius) if indenter == "paraboloid" else \

@@ -219,3 +219,12 @@ def test_scene_bad_basis(kwargs, match):
         flat_punch.build(MPI.COMM_WORLD, law="penalty", **kwargs)
     with pytest.raises(ValueError, match=match):
         mindlin.run(**kwargs)
+
+
+def test_mindlin_enforcement_and_augmented_refused():
+    """mindlin.run(enforcement=...) with augmented=True is ambiguous: refused before any mesh
+    is built, naming both quantities."""
+    from rough_contact.scenes import mindlin
+    with pytest.raises(ValueError, match="enforcement = .* with augmented = True is invalid"):
+        mindlin.run(points="nodal", basis="dual", augmented=True,
+                    enforcement=NewtonAugmentedLagrangian(1e-4))
