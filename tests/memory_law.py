@@ -18,7 +18,10 @@ C, LAM, DELTA = 50.0, 1e-3, 1.5e-3      # MPa, mm, mm
 
 
 class MemoryLaw:
-    """p = C exp(-h/LAM) on loading; p = p_L(h_min) x^1.5, x = 1 - (h - h_min)/DELTA unloading."""
+    """p = C exp(-h/LAM) on loading; p = p_L(h_min) x^1.5, x = 1 - (h - h_min)/delta unloading
+    (delta = DELTA unless a subclass sets another recovery extent)."""
+
+    delta = DELTA
 
     def evaluate(self, h, curvature=False):
         h = np.asarray(h, float)
@@ -33,13 +36,13 @@ class MemoryLaw:
         h, hm = np.broadcast_arrays(np.asarray(h, float), np.asarray(h_min, float))
         lo = np.minimum(h, hm)
         p0 = C * np.exp(-lo / LAM)
-        x = np.clip(1.0 - (h - lo) / DELTA, 0.0, 1.0)
+        x = np.clip(1.0 - (h - lo) / self.delta, 0.0, 1.0)
         un = h > hm
         p = np.where(un, p0 * x ** 1.5, p0)
-        k = np.where(un, 1.5 * p0 * np.sqrt(x) / DELTA, p0 / LAM)
+        k = np.where(un, 1.5 * p0 * np.sqrt(x) / self.delta, p0 / LAM)
         a = np.minimum(p / 100.0, 1.0)
         if curvature:
-            dk = np.where(un, -0.75 * p0 / (DELTA ** 2 * np.sqrt(np.maximum(x, 1e-300))),
+            dk = np.where(un, -0.75 * p0 / (self.delta ** 2 * np.sqrt(np.maximum(x, 1e-300))),
                           -p0 / LAM ** 2)
             return p, k, a, np.where(un & (x <= 0), 0.0, dk)
         return p, k, a
@@ -48,4 +51,4 @@ class MemoryLaw:
         """D(h_min) = int_{h_min}^inf p_load - int_{h_min}^{h_min + DELTA} p_unload."""
         hm = np.asarray(h_min, float)
         return np.where(np.isfinite(hm), C * np.exp(-np.minimum(hm, 1e300) / LAM)
-                        * (LAM - 0.4 * DELTA), 0.0)
+                        * (LAM - 0.4 * self.delta), 0.0)

@@ -30,48 +30,19 @@ from rough_contact.interface.state import HistoryInterfaceState
 from rough_contact.scenes import bolt_head, flat_punch
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))   # tests/: the shared stand-in law
-from memory_law import C, LAM  # noqa: E402
+from memory_law import C, LAM, MemoryLaw  # noqa: E402
 
 DELTA_STIFF = 0.5 * LAM          # k_rev/k_load = 3 at the reversal
 COARSE = dict(cycles=5, steps_per_cycle=8, size_cylinder=1.5, size_block=2.5, low=0.1,
               pressure=10.0, case="b", progress=False)
 
 
-class StiffUnloadingLaw:
-    """Closed-form law with memory whose unloading branch starts 1.5 LAM/delta times stiffer
-    than the loading branch (``HistoryNormalLawProtocol``)."""
+class StiffUnloadingLaw(MemoryLaw):
+    """The shared closed-form law with memory whose unloading branch starts 1.5 LAM/delta times
+    stiffer than the loading branch (``HistoryNormalLawProtocol``)."""
 
     def __init__(self, delta=DELTA_STIFF):
         self.delta = delta
-
-    def evaluate(self, h, curvature=False):
-        p = C * np.exp(-np.asarray(h, float) / LAM)
-        out = (p, p / LAM, np.minimum(p / 100.0, 1.0))
-        return out + (-p / LAM ** 2,) if curvature else out
-
-    def separation_for_pressure(self, p):
-        return -LAM * np.log(np.asarray(p, float) / C)
-
-    def evaluate_history(self, h, h_min, curvature=False):
-        d = self.delta
-        h, hm = np.broadcast_arrays(np.asarray(h, float), np.asarray(h_min, float))
-        lo = np.minimum(h, hm)
-        p0 = C * np.exp(-lo / LAM)
-        x = np.clip(1.0 - (h - lo) / d, 0.0, 1.0)
-        un = h > hm
-        p = np.where(un, p0 * x ** 1.5, p0)
-        k = np.where(un, 1.5 * p0 * np.sqrt(x) / d, p0 / LAM)
-        a = np.minimum(p / 100.0, 1.0)
-        if curvature:
-            dk = np.where(un, -0.75 * p0 / (d * d * np.sqrt(np.maximum(x, 1e-300))),
-                          -p0 / LAM ** 2)
-            return p, k, a, np.where(un & (x <= 0), 0.0, dk)
-        return p, k, a
-
-    def normal_dissipation(self, h_min):
-        hm = np.asarray(h_min, float)
-        return np.where(np.isfinite(hm), C * np.exp(-np.minimum(hm, 1e300) / LAM)
-                        * (LAM - 0.4 * self.delta), 0.0)
 
 
 class StiffUnloadingLawWithReversal(StiffUnloadingLaw):

@@ -72,6 +72,19 @@ def _mesh(model, mesh_size, order, cell_type):
     generate(model, order)
 
 
+def _size_boxes(model, faces: dict, sizes, cell_type: str) -> None:
+    """Each box meshed with its own element size: structured hexahedra per box, or tetrahedra
+    with the box's size on its boundary. ``sizes``: ((volume tag, size), ...)."""
+    if cell_type == "hexahedron":
+        _separate_hexahedra(model, faces, sizes)
+        return
+    import gmsh
+
+    for vol, size in sizes:
+        model.mesh.setSize(model.getBoundary([(3, vol)], recursive=True), size)
+    gmsh.option.setNumber("Mesh.MeshSizeMax", max(size for _, size in sizes))
+
+
 def _separate_hexahedra(model, faces: dict, sizes) -> None:
     """Structured hexahedra on boxes meshed independently: ``sizes = ((volume, size), ...)``,
     every curve of a volume's faces (``faces[volume]``) split into ``ceil(length / size)``
@@ -159,8 +172,6 @@ def separate_blocks(lx: float = 1.0, ly: float = 1.0, h1: float = 1.0, h2: float
     tol = 1e-6 * max(lx, ly, h1, h2)
 
     def build(model):
-        import gmsh
-
         lower, upper = _stacked_boxes(model, lx, ly, h1, h2)
         model.occ.synchronize()   # no fragment: two independent surface meshes on z = 0
         add_groups(model, 3, {"upper": (1, [upper]), "lower": (2, [lower])})
@@ -175,13 +186,7 @@ def separate_blocks(lx: float = 1.0, ly: float = 1.0, h1: float = 1.0, h2: float
             "top": (13, tags[np.abs(z - h2) < tol]),
             "bottom": (14, tags[np.abs(z + h1) < tol]),
             **_side_groups(model, lx, ly, tol)})
-        sizes = ((lower, size_lower), (upper, size_upper))
-        if cell_type == "hexahedron":
-            _separate_hexahedra(model, faces, sizes)
-        else:
-            for vol, size in sizes:
-                model.mesh.setSize(model.getBoundary([(3, vol)], recursive=True), size)
-            gmsh.option.setNumber("Mesh.MeshSizeMax", max(size_lower, size_upper))
+        _size_boxes(model, faces, ((lower, size_lower), (upper, size_upper)), cell_type)
         generate(model, order)
 
     return build_contact_scene(
@@ -234,15 +239,7 @@ def slider_on_slab(slab_length: float = 3.0, slider_length: float = 1.0, width: 
             "bottom": (14, pick(slab, np.abs(z + h_slab) < tol)),
             "y0_slider": (15, pick(slider, np.abs(y) < tol)),
             "y0_slab": (16, pick(slab, np.abs(y) < tol))})
-        sizes = ((slab, size_slab), (slider, size_slider))
-        if cell_type == "hexahedron":
-            _separate_hexahedra(model, faces, sizes)
-        else:
-            import gmsh
-
-            for vol, size in sizes:
-                model.mesh.setSize(model.getBoundary([(3, vol)], recursive=True), size)
-            gmsh.option.setNumber("Mesh.MeshSizeMax", max(size_slab, size_slider))
+        _size_boxes(model, faces, ((slab, size_slab), (slider, size_slider)), cell_type)
         generate(model, order)
 
     return build_contact_scene(
