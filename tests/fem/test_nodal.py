@@ -16,9 +16,11 @@ Run serial and in parallel:
 
 from __future__ import annotations
 
+import sys
+from pathlib import Path
+
 import numpy as np
 import pytest
-import ufl
 from mpi4py import MPI
 from petsc4py import PETSc
 
@@ -31,6 +33,9 @@ from rough_contact.interface.penalty import LinearPenalty, SoftplusPenalty
 from rough_contact.scenes.meshes.blocks import separate_blocks, two_blocks
 from rough_contact.solver.loading import load_path
 from rough_contact.solver.snes import SNESSolver
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))   # tests/: shared checks
+from interface_checks import interpolate_two_bodies, residual_jacobian_figures  # noqa: E402
 
 E, NU, PRESSURE = 2.0e5, 0.25, 80.0
 
@@ -101,17 +106,6 @@ def test_patch_uniform_pressure_is_transmitted_exactly(case, friction):
     assert ci.n_points_global < ci.comm.allreduce(ci.quadrature_points.n_points, op=MPI.SUM)
 
 
-def _interpolate_bodies(u, scene):
-    """A smooth displacement, different on each body (a jump across the interface)."""
-    for name, s in (("lower", 0.0), ("upper", 1.0)):
-        cells = scene.cell_tags.find(scene.tag(name))
-        compat.interpolate(u, lambda x: 2e-3 * np.stack([
-            np.sin(2 * x[0] + 1) * np.cos(x[1]) + 0.5 * s * np.cos(3 * x[1]),
-            np.cos(x[0] - 2 * x[1]) - 0.3 * s * np.sin(x[0]),
-            np.sin(x[0] + x[1] + x[2]) - 0.8 * s * (1 + x[0] * x[1])]), cells=cells)
-    u.x.scatter_forward()
-
-
 def _figures(comm, pairing, order, fd=False):
     """Force, residual and Jacobian norms, real and nominal area at a smooth non-uniform
     displacement with friction; optionally the finite-difference error of the Jacobian."""
@@ -125,43 +119,8 @@ def _figures(comm, pairing, order, fd=False):
     ci = NodalContactInterface(V, scene.facet_tags, *scene.contact_pair, law=law,
                                quadrature_degree=2 * order, pairing=pairing)
     u = fem.Function(V)
-    _interpolate_bodies(u, scene)
-    b = compat.create_petsc_vector(V)
-    b.set(0.0)
-    ci.evaluate(u)
-    ci.assemble_residual(b)
-    mass = fem.form(ufl.inner(ufl.TrialFunction(V), ufl.TestFunction(V)) * ufl.dx)
-    A = ci.create_matrix(mass)
-    ci.assemble_jacobian(A)
-    A.assemble()
-    figs = np.concatenate([ci.contact_force(), [b.norm(), A.norm(), ci.real_contact_area(),
-                                                ci.nominal_area()]])
-    fd_err = None
-    if fd:   # central differences of the residual along a random direction
-        rng = np.random.default_rng(3)
-        x = compat.petsc_vector(u).copy()
-        d = x.duplicate()
-        r0, r1 = d.getOwnershipRange()
-        d.setArray(rng.uniform(-1, 1, 3 * V.dofmap.index_map.size_global)[r0:r1] * 1e-4)
-        Jd = b.duplicate()
-        A.mult(d, Jd)
-        eps = 1e-5
-        res = []
-        for sgn in (1.0, -1.0):
-            xs = x.copy()
-            xs.axpy(sgn * eps, d)
-            bs = b.duplicate()
-            bs.set(0.0)
-            ci.evaluate(xs)
-            ci.assemble_residual(bs)
-            res.append(bs)
-        fd_vec = res[0].copy()
-        fd_vec.axpy(-1.0, res[1])
-        fd_vec.scale(0.5 / eps)
-        fd_vec.axpy(-1.0, Jd)
-        fd_err = fd_vec.norm() / Jd.norm()
-    A.destroy()
-    return figs, fd_err
+    interpolate_two_bodies(u, scene)
+    return residual_jacobian_figures(ci, u, V, fd)
 
 
 @pytest.mark.parametrize("pairing,order", [("conforming", 2), ("mortar", 1), ("mortar", 2)])

@@ -1,0 +1,72 @@
+"""Shared FE test helper: a contact interface's force, residual and Jacobian figures at one
+state, and the Jacobian checked against central differences of the residual.
+
+Imported by tests/fem/test_nodal.py and tests/fem/test_nonmatching.py (which put this folder on
+sys.path). Collective: every rank calls it.
+"""
+from __future__ import annotations
+
+import numpy as np
+import ufl
+
+from dolfinx import fem
+from rough_contact.fem import compat
+
+
+def residual_jacobian_figures(ci, u, V, fd: bool = False):
+    """Evaluate the interface ``ci`` at ``u`` and return (figures, fd_err).
+
+    figures: the contact force (3), then |residual|, |Jacobian| (Frobenius), real contact area
+    and nominal area -- quantities independent of the number of ranks.
+    fd_err: with ``fd``, |J d - (R(u + e d) - R(u - e d)) / 2e| / |J d| along a fixed
+    pseudo-random direction d (central differences, e = 1e-5); else None.
+    """
+    b = compat.create_petsc_vector(V)
+    b.set(0.0)
+    ci.evaluate(u)
+    ci.assemble_residual(b)
+    mass = fem.form(ufl.inner(ufl.TrialFunction(V), ufl.TestFunction(V)) * ufl.dx)
+    A = ci.create_matrix(mass)
+    ci.evaluate(u)
+    ci.assemble_jacobian(A)
+    A.assemble()
+    figs = np.concatenate([ci.contact_force(), [b.norm(), A.norm(), ci.real_contact_area(),
+                                                ci.nominal_area()]])
+    fd_err = None
+    if fd:
+        rng = np.random.default_rng(3)
+        x = compat.petsc_vector(u).copy()
+        d = x.duplicate()
+        r0, r1 = d.getOwnershipRange()
+        d.setArray(rng.uniform(-1, 1, 3 * V.dofmap.index_map.size_global)[r0:r1] * 1e-4)
+        Jd = b.duplicate()
+        A.mult(d, Jd)
+        eps = 1e-5
+        res = []
+        for sgn in (1.0, -1.0):
+            xs = x.copy()
+            xs.axpy(sgn * eps, d)
+            bs = b.duplicate()
+            bs.set(0.0)
+            ci.evaluate(xs)
+            ci.assemble_residual(bs)
+            res.append(bs)
+        fd_vec = res[0].copy()
+        fd_vec.axpy(-1.0, res[1])
+        fd_vec.scale(0.5 / eps)
+        fd_vec.axpy(-1.0, Jd)
+        fd_err = fd_vec.norm() / Jd.norm()
+    A.destroy()
+    return figs, fd_err
+
+
+def interpolate_two_bodies(u, scene):
+    """A smooth displacement, different on each body of ``scene`` (cells tagged "lower" and
+    "upper"): a non-uniform jump across the interface."""
+    for name, s in (("lower", 0.0), ("upper", 1.0)):
+        cells = scene.cell_tags.find(scene.tag(name))
+        compat.interpolate(u, lambda x: 2e-3 * np.stack([
+            np.sin(2 * x[0] + 1) * np.cos(x[1]) + 0.5 * s * np.cos(3 * x[1]),
+            np.cos(x[0] - 2 * x[1]) - 0.3 * s * np.sin(x[0]),
+            np.sin(x[0] + x[1] + x[2]) - 0.8 * s * (1 + x[0] * x[1])]), cells=cells)
+    u.x.scatter_forward()
