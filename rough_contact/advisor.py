@@ -48,6 +48,11 @@ n_quad = 8, n_t = 8: ~0.2 % from the converged sums), interpolated by cubic Herm
 ln p with the models' own stiffness as slope data. ``tests/unit/test_advisor.py`` checks the
 estimated differences against those of the full tables.
 
+Cost: the population calls take the cheaper options of :mod:`rough_contact.micro.population`
+(a coarse p-window search, the numpy-only Hermite table of the shape factors, which spares the
+first call of a process the import of scipy.interpolate and the spline build, and F_3/2, F_1/2
+from one parabolic-cylinder call); ``docs/advisor.md`` ("Cost") has the measured figures.
+
 Units: mm, N, MPa. Pure layer: numpy and scipy (no dolfinx).
 """
 
@@ -100,9 +105,11 @@ _NQ_EP, _NT_EP = 8, 8
 _BUILD_PER_ESTIMATE = {"greenwood_williamson": 200.0, "elastic": 120.0, "elasto-plastic": 1000.0}
 _N_PRESSURES = 7
 # Bracket width of the p-window search in the advisor's population calls (the default search
-# runs to the fixed point, ~140 calls of the window function; this one ~40: the window's
-# content is the same, its nodes move by < 1e-3)
-_WINDOW_TOL = 1e-3
+# runs to the fixed point, ~140 calls of the window function; this one ~20). The window's edge
+# lies where the integrand's bound is exp(-50) of its peak; p is a standard-normal variable, so
+# an edge moved by 0.05 moves that level by at most ~0.5 in the exponent: the window's content
+# is the same, its nodes move by < 0.05 (the estimates change by < 1e-4, measured)
+_WINDOW_TOL = 0.05
 
 # The FE results a scene may need within the tolerance (``advise(..., results=...)``):
 # "force" - the normal force distribution (seen through k at equal pressure), "area" - the real
@@ -408,6 +415,9 @@ class _Curve:
     p: np.ndarray
     k: np.ndarray
     a: np.ndarray
+    # at_pressure's results by pressures (the advisor asks a curve for the same pressures
+    # several times)
+    _memo: dict = field(default_factory=dict, compare=False, repr=False)
 
     @classmethod
     def of(cls, r, h: np.ndarray) -> "_Curve":
@@ -451,17 +461,35 @@ class _Curve:
         # the interval: ln p decreases along the knots
         i = np.clip(np.searchsorted(-lnp, -lnP, side="left") - 1, 0, self.h.size - 2)
         ci = c[:, i]
+        # Newton from the secant's root, kept inside a bracket [lo, hi] that every step
+        # narrows (a step leaving it is replaced by bisection): converged to 1e-13 of the
+        # interval in ~4 steps where the bisection took 34 to reach 6e-11
         lo, hi = np.zeros_like(lnP), np.ones_like(lnP)
-        for _ in range(34):                 # 6e-11 of the interval
-            mid = 0.5 * (lo + hi)
-            above = horner(ci, mid) > lnP
-            lo = np.where(above, mid, lo)
-            hi = np.where(above, hi, mid)
-        return self.h[i] + 0.5 * (lo + hi) * np.diff(self.h)[i]
+        t = np.clip((ci[0] - lnP) / (lnp[i] - lnp[i + 1]), 0.0, 1.0)
+        for _ in range(60):
+            f = horner(ci, t) - lnP
+            above = f > 0.0                 # ln p decreases in t: the root lies beyond t
+            lo = np.where(above, t, lo)
+            hi = np.where(above, hi, t)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                tn = t - f / horner_dt(ci, t)
+            tn = np.where((tn > lo) & (tn < hi), tn, 0.5 * (lo + hi))
+            done = np.max(np.abs(tn - t)) < 1e-13
+            t = tn
+            if done:
+                break
+        return self.h[i] + t * np.diff(self.h)[i]
 
     def at_pressure(self, P):
         """(h, k, a) at pressures P: k and ln a interpolated in h (limited three-point slopes
         for ln k and ln a: the stiffness data are exact at the knots)."""
+        P = np.asarray(P, float)
+        key = P.tobytes()
+        if key not in self._memo:
+            self._memo[key] = self._at_pressure(P)
+        return tuple(v.copy() for v in self._memo[key])
+
+    def _at_pressure(self, P):
         x = self.separation(P)
         lk, _ = hermite_eval(self.h, np.log(self.k), limited_slopes(self.h, np.log(self.k)), x)
         la, _ = hermite_eval(self.h, np.log(self.a), limited_slopes(self.h, np.log(self.a)), x)
@@ -644,7 +672,9 @@ def advise(surface, material: AsperityMaterial, pressure_range, tolerance: float
     timing["greenwood_williamson"] = (time.perf_counter() - t) / max(gw.h.size, 1)
     t = time.perf_counter()
     el, = _curves_over(lambda h: [population.elastic(surface, E, h, n_quad=_NQ_EL,
-                                                     window_tol=_WINDOW_TOL)], P,
+                                                     window_tol=_WINDOW_TOL,
+                                                     shape_table="hermite",
+                                                     inner="recurrence")], P,
                        (hg[0] - 0.5 * rq, hg[1] + 0.5 * rq), rq, 8)
     timing["elastic"] = (time.perf_counter() - t) / el.h.size
     he = el.separation(np.array([p_hi, p_lo]))
@@ -653,7 +683,8 @@ def advise(surface, material: AsperityMaterial, pressure_range, tolerance: float
     # cancel in the ratio
     ep, el_same = _curves_over(
         lambda h: population.elasto_plastic_and_elastic(surface, mat, h, n_quad=_NQ_EP,
-                                                        n_t=_NT_EP, window_tol=_WINDOW_TOL),
+                                                        n_t=_NT_EP, window_tol=_WINDOW_TOL,
+                                                        shape_table="hermite"),
         P, (he[0] - 0.5 * rq, he[1] + 0.25 * rq), rq, _N_EP)
     timing["elasto-plastic"] = (time.perf_counter() - t) / ep.h.size
 

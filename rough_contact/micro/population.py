@@ -151,6 +151,26 @@ def _log_F1_closed(d):
     return np.where(big, asym, core) - 0.5 * d * d
 
 
+def _log_F_half_pair(d):
+    """(log F_3/2(d), log F_1/2(d)) from one parabolic-cylinder call where -10 <= d <= 30:
+    pbdv(-5/2, d) gives D_-5/2 and its derivative, and D_-3/2 = d/2 D_-5/2 - D'_-5/2
+    (DLMF 12.8.3); outside, :func:`log_F_n`."""
+    d = np.asarray(d, dtype=float)
+    o32, o12 = np.empty(d.shape), np.empty(d.shape)
+    mid = (d >= -10.0) & (d <= 30.0)
+    if np.any(mid):
+        dm = d[mid]
+        D, Dp = special.pbdv(-2.5, dm)
+        c = -dm * dm / 4.0 - 0.5 * math.log(2 * math.pi)
+        o32[mid] = special.gammaln(2.5) + c + np.log(D)
+        o12[mid] = special.gammaln(1.5) + c + np.log(0.5 * dm * D - Dp)
+    out = ~mid
+    if np.any(out):
+        o32[out] = log_F_n(1.5, d[out])
+        o12[out] = log_F_n(0.5, d[out])
+    return o32, o12
+
+
 def F_n(n: float, d):
     """F_n(d) = int_0^inf t^n phi(t + d) dt (underflows to 0 for d > ~38)."""
     return np.exp(log_F_n(n, d))
@@ -313,8 +333,11 @@ def _outer_nodes(surface: SpectralMoments, l, n_quad, n_p=None, window_tol=0.0, 
     return r4, r6, d, logw
 
 
-def _asperity_shape(surface, r4, r6, elliptic, eccentricity):
-    """kappa_m (44) [1/mm], e1, shape factors at the (r4, r6) nodes (r4, r6 > 0)."""
+def _asperity_shape(surface, r4, r6, elliptic, eccentricity, shape_table="spline"):
+    """kappa_m (44) [1/mm], e1, shape factors at the (r4, r6) nodes (r4, r6 > 0).
+
+    ``shape_table``: the interpolant of the exact shape factors (``eccentricity="exact"``),
+    see :func:`~rough_contact.micro.asperity.shape_factors_from_lambda`'s ``table``."""
     s40, s04 = math.sqrt(surface.m40), math.sqrt(surface.m04)
     kx = np.maximum(r4 * s40, 1e-300)   # principal curvatures w4 sqrt(m40 mu) etc. [1/mm]
     ky = np.maximum(r6 * s04, 1e-300)
@@ -322,7 +345,7 @@ def _asperity_shape(surface, r4, r6, elliptic, eccentricity):
     # lambda^2 = b^2/a^2 = kx/ky; the shape factors are symmetric, use lambda <= 1
     lam = np.exp(-0.5 * np.abs(np.log(kx) - np.log(ky)))
     if eccentricity == "exact":
-        f1, f2, f3, KE = shape_factors_from_lambda(lam, elliptic)
+        f1, f2, f3, KE = shape_factors_from_lambda(lam, elliptic, shape_table)
     elif eccentricity == "paper":
         e1 = eccentricity_from_lambda(lam, method="paper")
         f1, f2, f3, _, KE = shape_factors(e1, elliptic)
@@ -343,7 +366,8 @@ def _chunks(n_h, per_h, budget=1_500_000):
 
 def elastic(surface: SpectralMoments, E_star: float, h, n_quad: int = 32,
             elliptic: str = "exact", eccentricity: str = "exact",
-            window_tol: float = 0.0) -> PopulationResult:
+            window_tol: float = 0.0, shape_table: str = "spline",
+            inner: str = "pbdv") -> PopulationResult:
     """Elastic anisotropic population, eqs (52), (53), (55).
 
     Args:
@@ -356,11 +380,22 @@ def elastic(surface: SpectralMoments, E_star: float, h, n_quad: int = 32,
         window_tol: > 0 ends the search of the p window at that bracket width (a cheaper
             search for coarse estimates, e.g. 1e-3 in ``rough_contact.advisor``); 0: to the
             fixed point (see ``_p_windows``).
+        shape_table: "spline" (default) or "hermite": the interpolant of the exact shape
+            factors (:func:`~rough_contact.micro.asperity.shape_factors_from_lambda`, its
+            ``table``; "hermite" is within 1e-7 of the spline and needs no scipy.interpolate:
+            for the advisor's first call of a process).
+        inner: the closed forms of the inner t integrals: "pbdv" (default) -- one
+            :func:`log_F_n` (scipy ``pbdv``) per order; "recurrence" -- F_3/2 and F_1/2 from
+            one ``pbdv`` call (D_-3/2 = x/2 D_-5/2 - D'_-5/2) and F_1 in closed form
+            (erfcx): half the cost, within 1e-13 of the default for F_3/2 and F_1/2 and
+            1e-8 for F_1 (the advisor's estimates).
     Returns:
         PopulationResult (area_fraction, pressure [MPa], stiffness [MPa/mm]) shaped like h.
     """
     E_star = check_scalar("E_star", E_star, lo=0.0, unit="MPa")
     n_quad = _check_nquad(n_quad)
+    if inner not in ("pbdv", "recurrence"):
+        raise ValueError(f"inner = {inner!r} is invalid: valid values are 'pbdv', 'recurrence'")
     shape, l, smu, Ds = _separations(surface, h)
     A = np.zeros(l.size)
     W = np.zeros(l.size)
@@ -368,10 +403,15 @@ def elastic(surface: SpectralMoments, E_star: float, h, n_quad: int = 32,
     per_h = 3 * n_quad * 3 * n_quad
     for sl in _chunks(l.size, per_h):
         r4, r6, d, logw = _outer_nodes(surface, l[sl], n_quad, window_tol=window_tol)
-        kappa, _, _, f1, f2, _, _ = _asperity_shape(surface, r4, r6, elliptic, eccentricity)
-        F1 = log_F_n(1.0, d)[..., None]
-        F32 = log_F_n(1.5, d)[..., None]
-        F12 = log_F_n(0.5, d)[..., None]
+        kappa, _, _, f1, f2, _, _ = _asperity_shape(surface, r4, r6, elliptic, eccentricity,
+                                                    shape_table)
+        if inner == "recurrence":
+            F1 = _log_F1_closed(d)[..., None]
+            F32, F12 = (x[..., None] for x in _log_F_half_pair(d))
+        else:
+            F1 = log_F_n(1.0, d)[..., None]
+            F32 = log_F_n(1.5, d)[..., None]
+            F12 = log_F_n(0.5, d)[..., None]
         A[sl] = np.sum(f1 / kappa * np.exp(logw + F1), axis=(1, 2))
         g2 = f2 / np.sqrt(kappa)
         W[sl] = np.sum(g2 * np.exp(logw + F32), axis=(1, 2))
@@ -410,19 +450,19 @@ def elasto_plastic(surface: SpectralMoments, material: AsperityMaterial, h, n_qu
 
 def elasto_plastic_and_elastic(surface: SpectralMoments, material: AsperityMaterial, h,
                                n_quad: int = 24, n_t: int | None = None,
-                               window_tol: float = 0.0):
+                               window_tol: float = 0.0, shape_table: str = "spline"):
     """The elasto-plastic sums and the purely elastic ones on the same quadrature nodes.
 
     The elastic result uses the elasto-plastic quadrature (inner t rule instead of the closed
     forms of :func:`elastic`): with a coarse rule both carry nearly the same quadrature error,
     which cancels in their ratio (what ``rough_contact.advisor`` compares). Arguments as in
-    :func:`elasto_plastic`; ``window_tol`` as in :func:`elastic`.
+    :func:`elasto_plastic`; ``window_tol`` and ``shape_table`` as in :func:`elastic`.
 
     Returns:
         (elasto-plastic PopulationResult, elastic PopulationResult).
     """
     return _elasto_plastic(surface, material, h, n_quad, "exact", "exact", n_t, True,
-                           window_tol)
+                           window_tol, shape_table)
 
 
 _EP_KEYS = ("Ae", "At", "Ap", "We", "Wt", "Wp", "K")
@@ -477,7 +517,7 @@ def _transition_sums(a, b, u, w, smu, R, chH, slope, d, f1, f3, c_area, wc, wp):
 
 
 def _elasto_plastic(surface, material, h, n_quad, elliptic, eccentricity, n_t, elastic_too,
-                    window_tol=0.0):
+                    window_tol=0.0, shape_table="spline"):
     """The elasto-plastic sums (and the elastic ones on the same nodes when ``elastic_too``).
 
     The inner t rule has four panels per (h, p, q) node, split at omega_c*, omega_p* and the
@@ -511,7 +551,8 @@ def _elasto_plastic(surface, material, h, n_quad, elliptic, eccentricity, n_t, e
     for sl in _chunks(l.size, n_pq, budget=_PQ_BUDGET):
         r4, r6, d, logw = _outer_nodes(surface, l[sl], n_quad, n_p, window_tol,
                                        windows=(windows[0][sl], windows[1][sl]))
-        kappa, _, _, f1, f2, f3, KE = _asperity_shape(surface, r4, r6, elliptic, eccentricity)
+        kappa, _, _, f1, f2, f3, KE = _asperity_shape(surface, r4, r6, elliptic, eccentricity,
+                                                      shape_table)
         ex = np.exp(logw)
         d = np.broadcast_to(d[..., None], r4.shape)      # (n_h, n_p, n_q)
         wc = KE * (pY / Es) ** 2 / kappa          # (65) [mm]

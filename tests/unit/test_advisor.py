@@ -422,3 +422,21 @@ def test_bem_check_refuses_the_statistical_law_on_a_broadband_surface():
     adv = advise(s, mat, (5.0, 50.0), 0.05, bem_check=BEMCheck(pixels_per_wavelength=2,
                                                                 cache=False))
     assert adv.bem_check.verdict == "refused" and adv.normal == "bem", adv.report()
+
+
+def test_curve_separation_inverts_the_interpolated_pressure():
+    # _Curve.separation (Newton inside a shrinking bracket) against the forward evaluation
+    # at_h of the same Hermite curve: p(h(P)) = P; and at_pressure's memo returns copies
+    from rough_contact.advisor import _Curve
+
+    s = table1()
+    h = np.linspace(0.0, 3.5, 8) * s.rq
+    c = _Curve.of(population.elastic(s, E_STAR, h, n_quad=16), h)
+    P = np.geomspace(c.p[-1] * 1.0001, c.p[0] * 0.9999, 57)
+    x = c.separation(P)
+    assert np.all(np.diff(x) < 0)
+    p, _ = c.at_h(x)
+    assert np.max(np.abs(p / P - 1.0)) < 1e-11
+    a = c.at_pressure(P)
+    a[0][:] = 0.0
+    assert np.array_equal(c.at_pressure(P)[0], x)

@@ -176,3 +176,22 @@ def test_material_conventions_and_errors():
         asp.elliptic_integrals(np.array([0.0]))
     with pytest.raises(ValueError, match="NaN"):
         asp.shape_factors(np.array([np.nan]))
+
+
+def test_hermite_shape_table_against_the_exact_inversion():
+    # table="hermite" (the advisor's numpy-only table) against the shape factors at the exact
+    # inversion of (27) by bisection (an independent route): within 2e-7 on [e^-40, 1], exact
+    # beyond; lambda > 1 maps to 1/lambda; the spline default is untouched
+    rng = np.random.default_rng(3)
+    lam = np.exp(np.concatenate([-rng.uniform(0.0, 40.0, 2000), -rng.uniform(0.0, 1e-3, 200),
+                                 [0.0, -1e-12, -39.999999, -40.0, -40.000001, -120.0]]))
+    f1, f2, f3, _, KE = asp.shape_factors(asp.eccentricity_from_lambda(lam))
+    exact = np.stack([f1, f2, f3, KE])
+    fast = np.stack(asp.shape_factors_from_lambda(lam, table="hermite"))
+    assert np.max(np.abs(fast / exact - 1.0)) < 2e-7
+    assert np.allclose(np.stack(asp.shape_factors_from_lambda(1.0 / lam, table="hermite")),
+                       fast, rtol=1e-12, atol=0)
+    spline = np.stack(asp.shape_factors_from_lambda(lam))
+    assert np.max(np.abs(spline / exact - 1.0)) < 1e-9
+    with pytest.raises(ValueError, match="table = 'cubic'"):
+        asp.shape_factors_from_lambda(lam, table="cubic")

@@ -214,3 +214,53 @@ def test_window_search_closed_form_F1_and_tolerance():
         for q in ("pressure", "stiffness", "area_fraction"):
             assert np.all(np.isfinite(getattr(r1, q))), q
             assert np.allclose(getattr(r1, q), getattr(r0, q), rtol=1e-4, atol=0), q
+
+
+def test_advisor_options_shape_table_and_inner_recurrence():
+    # F_3/2 and F_1/2 from one pbdv call (D_-3/2 = x/2 D_-5/2 - D'_-5/2) against one pbdv call
+    # per order, and against the recurrence F_5/2 = (3/2) F_1/2 - d F_3/2 (integration by
+    # parts; F_5/2 from its own pbdv call)
+    d = np.linspace(-15.0, 60.0, 3001)
+    f32, f12 = pop._log_F_half_pair(d)
+    assert np.max(np.abs(f32 - pop.log_F_n(1.5, d))) < 1e-12
+    assert np.max(np.abs(f12 - pop.log_F_n(0.5, d))) < 1e-12
+    m = (d > -10) & (d < 20)
+    f52 = 1.5 * np.exp(f12[m]) - d[m] * np.exp(f32[m])
+    assert np.allclose(f52, pop.F_n(2.5, d[m]), rtol=1e-9, atol=0)
+    # the advisor's cheap options give the same sums as the defaults, to the accuracy of the
+    # Hermite shape table (2e-7) and of the closed-form F_1 (1e-8)
+    s = SpectralMoments(m00=0.625, m20=8e-5, m02=8e-4, m40=1.04e-6, m04=1.04e-4, unit="um")
+    h = np.linspace(-1.0, 4.0, 6) * s.rq
+    a = pop.elastic(s, 1e5, h, n_quad=16)
+    b = pop.elastic(s, 1e5, h, n_quad=16, shape_table="hermite", inner="recurrence")
+    for q in ("pressure", "stiffness", "area_fraction"):
+        assert np.allclose(getattr(b, q), getattr(a, q), rtol=3e-7, atol=0), q
+    mat = AsperityMaterial(E_star=1e5, nu=0.3, psi=1.0)
+    ref = pop.elasto_plastic_and_elastic(s, mat, h, n_quad=8, n_t=8)
+    fast = pop.elasto_plastic_and_elastic(s, mat, h, n_quad=8, n_t=8, shape_table="hermite")
+    for r0, r1 in zip(ref, fast):
+        for q in ("pressure", "stiffness", "area_fraction"):
+            assert np.allclose(getattr(r1, q), getattr(r0, q), rtol=3e-6, atol=0), q
+    with pytest.raises(ValueError, match="inner = 'series'"):
+        pop.elastic(s, 1e5, h, inner="series")
+
+
+def test_advisor_first_call_needs_no_scipy_interpolate():
+    # the first population sums of a fresh process (what a run's --law auto meets) must not pay
+    # the import of scipy.interpolate nor the shape-factor spline (docs/advisor.md, "Cost")
+    import subprocess
+    import sys
+
+    code = ("import sys, warnings\n"
+            "from rough_contact.advisor import advise\n"
+            "from rough_contact.micro import asperity\n"
+            "from rough_contact.micro.asperity import AsperityMaterial\n"
+            "from rough_contact.surface import SpectralMoments\n"
+            "s = SpectralMoments(m00=0.625, m20=8e-5, m02=8e-4, m40=1.04e-6, m04=1.04e-4, "
+            "unit='um')\n"
+            "m = AsperityMaterial(E_star=1.067e5, nu=0.25, Y=2070.0, K_Y=1.62, psi=0.35)\n"
+            "advise(s, m, (0.156, 5.0), 0.05)\n"
+            "print('scipy.interpolate' in sys.modules, asperity._shape_spline.cache_info().currsize)\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True)
+    assert out.stdout.split() == ["False", "0"], out.stdout
