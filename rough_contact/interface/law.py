@@ -347,8 +347,8 @@ def _check_multipliers(multipliers) -> np.ndarray:
                          f"(first index {bad[0]}: {lam[bad[0]].tolist()} MPa); valid: finite")
     if lam.shape[0] and lam[:, 0].min() < 0.0:
         i = int(np.argmin(lam[:, 0]))
-        raise ValueError(f"multipliers[:, 0] (lambda_N, a contact pressure) = {lam[i, 0]!r} MPa "
-                         f"at point {i} is invalid: it must be >= 0")
+        raise ValueError(f"multipliers[:, 0] (lambda_N, a contact pressure) = "
+                         f"{float(lam[i, 0])!r} MPa at point {i} is invalid: it must be >= 0")
     return lam
 
 
