@@ -1,13 +1,14 @@
 """Exact stick for the rough law's friction, its normal compliance untouched (issue 22).
 
-Two blocks (1 x 1 x 1 mm on 1 x 1 x 0.5 mm, P1 tetrahedra, conforming), the lower one clamped
-at its bottom, the upper one held by the rough interface alone: the statistical normal law
-p(h) of the paper's punch surface (elastic asperities, ``NormalLaw.elastic``), k_T = 0.7 kN,
-isotropic slip-hardening friction (mu from 0.25 to 0.5, hardening rate 3e4 / mm: the
-micro-slips of a partial shear, ~1e-6 mm, harden it by a few per cent). A normal pressure P on the top,
-then a shear Q on the top (below the sliding load). The rough law on the nodal point set with
-the dual basis, under ``AugmentedLagrangian`` (Uzawa) and ``NewtonAugmentedLagrangian``
-(multipliers inside Newton), and for contrast under ``Penalty()``:
+Two blocks (upper 1 x 1 x 0.5 mm on lower 1 x 1 x 1 mm, P1 tetrahedra, conforming, 45
+interface vertices), the lower one clamped at its bottom, the upper one held by the rough
+interface alone: the statistical normal law p(h) of the paper's punch surface (elastic
+asperities, ``NormalLaw.elastic``), k_T = 0.7 kN, isotropic slip-hardening friction (mu from
+0.25 to 0.5, hardening rate 3e4 / mm: the micro-slips of a partial shear, ~1e-6 mm, harden it
+by a few per cent). A normal pressure P = 400 MPa on the top, then a shear Q = 64 MPa on the
+top (below the sliding load). The rough law on the nodal point set with the dual basis, under
+``AugmentedLagrangian`` (Uzawa) and ``NewtonAugmentedLagrangian`` (multipliers inside Newton),
+and for contrast under ``Penalty()``:
 
 (a) every vertex's pressure is the rough law's p(h0 + g) at its converged gap, the normal law
     evaluated directly (the enforcement does not touch the physical normal compliance; the
@@ -130,6 +131,8 @@ def penalty(rough_law):
 
 @pytest.mark.parametrize("name", list(ENFORCEMENTS))
 def test_exact_stick_normal_untouched(rough_law, penalty, name):
+    """(a)-(e) of the module for Uzawa's and the in-Newton multipliers (measured: 37 vertices
+    stick, 8 slip; k_T |s - s_p| = 7e-9 / 8e-9 of the largest traction, the penalty's 0.139)."""
     r = _run(rough_law, ENFORCEMENTS[name](), MPI.COMM_WORLD)
     law = rough_law
     assert all(inc.cutbacks == 0 for inc in r["incs"])
@@ -137,8 +140,8 @@ def test_exact_stick_normal_untouched(rough_law, penalty, name):
     stick = r["contact"] & ~r["slipping"]
     slip = r["slipping"]
     print(name, "stick", stick.sum(), "slip", slip.sum(), "of", n, "updates",
-          [inc.augmentations for inc in r["incs"]], "newton its", [inc.newton_total for inc in r["incs"]],
-          "newton updates", r["updates"])
+          [inc.augmentations for inc in r["incs"]], "newton its",
+          [inc.newton_total for inc in r["incs"]], "newton updates", r["updates"])
     assert r["contact"].all() and stick.sum() >= 5 and slip.sum() >= 5
     # (a) the pressure is p(h) of the rough law at the vertex's converged gap
     p = law.normal.evaluate(law.h0 + r["gap"])[0]
