@@ -49,6 +49,10 @@ Decisions (documented in ``docs/equations.md``):
     * The tangent returned is the ALGORITHMIC one (derivative of the discrete map), including the
       coupling to the normal jump through p(h) and kT(h); ``continuum_tangent`` gives the paper's
       (107)-(110) for comparison.
+    * Multipliers (exact stick by an augmented-Lagrangian enforcement): the elastic predictor
+      may be shifted, t_trial = lambda_T + K_T e (``FrictionInput.trial_shift_x/_y``); everything
+      after the predictor is the same map with that t_trial (the plastic increment is
+      Delta s_p = e - (t - lambda_T) / K_T, the hardening follows it).
 
 Sign convention (the interface-law contract, ``rough_contact.interface.contract``):
 t = dpsi/djump, jump = (g, s_x, s_y), t_N = -p, so the friction traction t_T points along the
@@ -76,6 +80,7 @@ __all__ = [
     "OrthotropicSlipHardening",
     "IsotropicSlipHardening",
     "FrictionInput",
+    "ShiftedFrictionInput",
     "FrictionOutput",
     "ReturnMappingError",
     "continuum_tangent",
@@ -117,6 +122,9 @@ class FrictionInput:
         slip_path: committed effective plastic slip (path length), hardening variable of the
             isotropic law (119) [mm].
 
+    The elastic predictor is t_trial = K_T e; :class:`ShiftedFrictionInput` adds tangential
+    multipliers to it.
+
     Raises:
         ValueError: a column that is not a 1-D array, or columns of different lengths. Values
             are not checked here (``evaluate`` is the hot path; ``from_pairs`` checks them).
@@ -145,9 +153,11 @@ class FrictionInput:
     def __len__(self) -> int:
         return self.elastic_slip_x.shape[0]
 
+    shifted = False    # the elastic predictor is K_T e (ShiftedFrictionInput: + lambda_T)
+
     @classmethod
     def from_pairs(cls, elastic_slip, kt, dkt, pressure, kn, accumulated_slip,
-                   slip_path) -> FrictionInput:
+                   slip_path, trial_shift=None) -> FrictionInput:
         """The validated input from (m, 2) pairs and (m,) arrays (every value checked).
 
         Args:
@@ -159,6 +169,8 @@ class FrictionInput:
             accumulated_slip: (m, 2) committed hardening variables kappa_x, kappa_y [mm]
                 (orthotropic law).
             slip_path: (m,) committed effective plastic slip [mm] (isotropic law).
+            trial_shift: optional (m, 2) tangential multipliers lambda_T [MPa] shifting the
+                elastic predictor (a :class:`ShiftedFrictionInput`; None: the plain input).
 
         Raises:
             ValueError: a wrong shape, a non-finite value, p < 0, kT <= 0 or kN < 0.
@@ -171,7 +183,10 @@ class FrictionInput:
         for name, arr, shape in (("kt", kt, (m, 2)), ("dkt", dkt, (m, 2)),
                                  ("pressure", pressure, (m,)), ("kn", kn, (m,)),
                                  ("accumulated_slip", accumulated_slip, (m, 2)),
-                                 ("slip_path", slip_path, (m,))):
+                                 ("slip_path", slip_path, (m,)),
+                                 ("trial_shift", trial_shift, (m, 2))):
+            if arr is None:     # no trial_shift
+                continue
             a = np.asarray(arr, dtype=float)
             if a.shape != shape:
                 raise ValueError(f"{name} must have shape {shape}, got {a.shape}")
@@ -189,13 +204,46 @@ class FrictionInput:
         if np.any(arrs["kn"] < 0):
             raise ValueError("kn (normal stiffness) must be >= 0 at every point [MPa/mm]")
         kt, dkt, kap = arrs["kt"], arrs["dkt"], arrs["accumulated_slip"]
-        return cls(e[:, 0].copy(), e[:, 1].copy(), kt[:, 0].copy(), kt[:, 1].copy(),
-                   dkt[:, 0].copy(), dkt[:, 1].copy(), arrs["pressure"], arrs["kn"],
-                   kap[:, 0].copy(), kap[:, 1].copy(), arrs["slip_path"])
+        cols = (e[:, 0].copy(), e[:, 1].copy(), kt[:, 0].copy(), kt[:, 1].copy(),
+                dkt[:, 0].copy(), dkt[:, 1].copy(), arrs["pressure"], arrs["kn"],
+                kap[:, 0].copy(), kap[:, 1].copy(), arrs["slip_path"])
+        shift = arrs.get("trial_shift")
+        if shift is None:
+            return cls(*cols)
+        return ShiftedFrictionInput(*cols, shift[:, 0].copy(), shift[:, 1].copy())
 
     def take(self, idx) -> FrictionInput:
-        """The columns at points ``idx`` (a gathered copy)."""
-        return FrictionInput(*(getattr(self, f).take(idx) for f in self.__dataclass_fields__))
+        """The columns at points ``idx`` (a gathered copy, of the same type)."""
+        return type(self)(*(getattr(self, f).take(idx) for f in self.__dataclass_fields__))
+
+    def trial_slip(self) -> Tuple[np.ndarray, np.ndarray]:
+        """(e_x, e_y) with t_trial = K_T (e_x, e_y) [mm]: here the elastic slip."""
+        return self.elastic_slip_x, self.elastic_slip_y
+
+
+@dataclass(frozen=True)
+class ShiftedFrictionInput(FrictionInput):
+    """A :class:`FrictionInput` whose elastic predictor is shifted by tangential multipliers:
+    t_trial = lambda_T + K_T e (the rough law under an augmented-Lagrangian enforcement,
+    ``InterfaceLaw.with_multipliers``). The return map is otherwise the same: the corrected
+    traction, the plastic slip increment Delta s_p = e - (t - lambda_T) / K_T and the hardening
+    follow from t_trial; the g-column of the tangent keeps d t_trial / dg = dK_T/dg e (the
+    shift does not depend on the jump).
+
+    Attributes (besides :class:`FrictionInput`'s):
+        trial_shift_x, trial_shift_y: (m,) tangential multipliers lambda_x, lambda_y [MPa].
+    """
+
+    trial_shift_x: np.ndarray
+    trial_shift_y: np.ndarray
+
+    shifted = True
+
+    def trial_slip(self) -> Tuple[np.ndarray, np.ndarray]:
+        """(e_x, e_y) with t_trial = K_T (e_x, e_y): e + lambda_T / K_T [mm] (K_T > 0, as the
+        return map needs)."""
+        return (self.elastic_slip_x + self.trial_shift_x / self.kt_x,
+                self.elastic_slip_y + self.trial_shift_y / self.kt_y)
 
 
 @dataclass(frozen=True)
@@ -361,9 +409,13 @@ def _initial_bracket(excess_num, p, ax, ay, qx2, qy2, n_lo):
 
 
 def _write_stick(c: FrictionInput, out_t, out_D):
-    """Elastic (stick) values at every point: t = K_T e, dt/d(g, s) = [dK_T e, K_T]."""
+    """Elastic (stick) values at every point: t = K_T e (+ lambda_T when shifted),
+    dt/d(g, s) = [dK_T e, K_T]."""
     tx = c.kt_x * c.elastic_slip_x
     ty = c.kt_y * c.elastic_slip_y
+    if c.shifted:
+        tx += c.trial_shift_x
+        ty += c.trial_shift_y
     out_t[:, 0] = tx
     out_t[:, 1] = ty
     out_D[:, 0, 0] = c.dkt_x * c.elastic_slip_x
@@ -410,8 +462,11 @@ def _spread(ax, ay):
     return np.minimum(ax, ay) / np.maximum(ax, ay)
 
 
-def _released(c: FrictionInput, ux, uy, mux, muy):
+def _released(c: FrictionInput, ex, ey, ux, uy, mux, muy):
     """Limit p << |t_trial| (p/N_trial < 1e-16 min(a)/max(a)): all elastic slip turns plastic.
+
+    (ex, ey) = t_trial / K_T (``FrictionInput.trial_slip``: the elastic slip e, plus
+    lambda_T / K_T when the predictor is shifted), (ux, uy) the slip direction of the potential.
 
     The exact map gives t = t_trial/(1 + lam a) with lam a_i ~ N_trial/p; to double precision
     t = p u/||u/mu|| with u the slip direction of the potential, Delta s_p = e - t/kT, and the
@@ -427,7 +482,7 @@ def _released(c: FrictionInput, ux, uy, mux, muy):
     ty = c.pressure * dy
     D = {(0, 0): -c.kn * dx, (0, 1): 0.0, (0, 2): 0.0, (1, 0): -c.kn * dy, (1, 1): 0.0,
          (1, 2): 0.0}
-    return tx, ty, c.elastic_slip_x - tx / c.kt_x, c.elastic_slip_y - ty / c.kt_y, D
+    return tx, ty, ex - tx / c.kt_x, ey - ty / c.kt_y, D
 
 
 def _pick(v, idx):
@@ -585,10 +640,10 @@ class OrthotropicSlipHardening(_SlipHardening):
         return released, (mux, muy, wy, cx, cy, ntr, ax, ay)
 
     def _release(self, s: FrictionInput, _mux, _muy, wy, *_):
-        ux, uy = s.elastic_slip_x, s.elastic_slip_y / wy       # w_x = 1
-        mx, _, my, _ = self._mu(s.kappa_x + np.abs(s.elastic_slip_x),
-                                s.kappa_y + np.abs(s.elastic_slip_y))
-        return _released(s, ux, uy, mx, my)
+        ex, ey = s.trial_slip()
+        ux, uy = ex, ey / wy       # w_x = 1
+        mx, _, my, _ = self._mu(s.kappa_x + np.abs(ex), s.kappa_y + np.abs(ey))
+        return _released(s, ex, ey, ux, uy, mx, my)
 
     def _return_map(self, s: FrictionInput, mux_n, muy_n, wy, cx, cy, ntr, ax, ay):
         mmx, mmy = self.mu_macro
@@ -692,8 +747,9 @@ class IsotropicSlipHardening(_SlipHardening):
         return released, (mu, cx, cy, T)
 
     def _release(self, s: FrictionInput, *_):
-        mu, _ = self._mu(s.slip_path + np.hypot(s.elastic_slip_x, s.elastic_slip_y))
-        return _released(s, s.elastic_slip_x, s.elastic_slip_y, mu, mu)
+        ex, ey = s.trial_slip()
+        mu, _ = self._mu(s.slip_path + np.hypot(ex, ey))
+        return _released(s, ex, ey, ex, ey, mu, mu)
 
     def _return_map(self, s: FrictionInput, mu_n, cx, cy, T):
         """Radial when kTx == kTy (and dkTx == dkTy), else the general scalar return map."""

@@ -25,12 +25,14 @@ import numpy as np
 
 from ..validation import check_scalar
 from .contract import LawResult, check_jump
-from .friction import FrictionInput, IsotropicSlipHardening, OrthotropicSlipHardening
+from .friction import (FrictionInput, IsotropicSlipHardening, OrthotropicSlipHardening,
+                       ShiftedFrictionInput)
 from .history import HistoryNormalLawProtocol, ReversalStiffnessProtocol
 from .state import HistoryInterfaceState, InterfaceState
 from .tangential import TangentialStiffness
 
-__all__ = ["InterfaceLaw", "NormalLawProtocol", "SeatableNormalLaw", "ValidityLimitedNormalLaw"]
+__all__ = ["InterfaceLaw", "ShiftedInterfaceLaw", "NormalLawProtocol", "SeatableNormalLaw",
+           "ValidityLimitedNormalLaw"]
 
 Friction = Union[OrthotropicSlipHardening, IsotropicSlipHardening]
 
@@ -107,6 +109,22 @@ class InterfaceLaw:
     tangent to the stiffer first unloading stiffness). Without the scale the tangential
     traction c k_N (s - s_p) jumps at h = h_min, and the residual is discontinuous at the
     peak of every repeated load cycle (Newton stalls; docs/unloading_scenes.md).
+
+    Multipliers (``rough_contact.interface.contract.MultiplierLaw``, exact stick): with an
+    augmented-Lagrangian enforcement (``AugmentedLagrangian``, ``NewtonAugmentedLagrangian``)
+    the law is evaluated as ``with_multipliers(lambda)``, lambda = (lambda_N, lambda_x,
+    lambda_y) per point. Only the FRICTION part is shifted: the trial traction of the return
+    map becomes t_trial = lambda_T + K_T(h) (s - s_p) (same return map otherwise: slip
+    hardening, orthotropic criterion, non-associated potential, algorithmic tangent). The
+    normal pressure p(h), its stiffness kN(h), the area fraction and the normal memory are the
+    unshifted law's, bit for bit: the asperity model's normal compliance is physical and stays
+    in the answer. lambda_N is not used (the enforcement's update sets it to the converged
+    pressure p, which the shifted law reproduces anyway); it must still be finite and >= 0.
+    At the enforcement's fixed point (lambda_T = the converged tangential traction) a sticking
+    point has s = s_p (no elastic slip) and a slipping point slips only plastically: the
+    option replaces the tangential micro-compliance K_T = c kN (the Mindlin stiffness of the
+    asperity contacts) by rigid stick. With ``Penalty()`` (the default) the law keeps the
+    paper's tangential compliance. A frictionless law's ``with_multipliers`` is the law itself.
     """
 
     normal: NormalLawProtocol
@@ -170,6 +188,26 @@ class InterfaceLaw:
             return np.zeros(len(state))
         return np.asarray(self.normal.normal_dissipation(state.h_min), dtype=float)
 
+    def with_multipliers(self, multipliers: np.ndarray) -> InterfaceLawProtocol:
+        """The law with its friction trial traction shifted by the tangential multipliers
+        (``rough_contact.interface.contract.MultiplierLaw``; see the class).
+
+        Args:
+            multipliers: (n, 3) [lambda_N, lambda_x, lambda_y] [MPa], finite, lambda_N >= 0
+                (lambda_N is not used: the normal law stays the unshifted p(h)).
+
+        Returns:
+            A :class:`ShiftedInterfaceLaw` for those n points; the law itself when it is
+            frictionless (nothing to shift).
+
+        Raises:
+            ValueError: ``multipliers`` not (n, 3), not finite, or lambda_N < 0.
+        """
+        lam = _check_multipliers(multipliers)
+        if self.friction is None:
+            return self
+        return ShiftedInterfaceLaw(self, lam)
+
     def evaluate(self, jump: np.ndarray, committed: InterfaceState) -> LawResult:
         """Traction, consistent tangent and trial state at jump (n, 3) [mm]; never mutates input.
 
@@ -185,6 +223,12 @@ class InterfaceLaw:
             rough_contact.interface.contract.ConvergenceError: non-finite jump, or
                 ``ReturnMappingError`` (a subclass) when the local Newton fails.
         """
+        return self._evaluate(jump, committed, None)
+
+    def _evaluate(self, jump: np.ndarray, committed: InterfaceState,
+                  shift: Optional[np.ndarray]) -> LawResult:
+        """``evaluate`` with the friction trial traction shifted by ``shift`` (n, 2) [MPa]
+        (None: the plain law)."""
         if self.h0 is None:
             raise ValueError("h0 (reference separation [mm]) is not set: pass h0= or use "
                              "with_seating(p_seat)")
@@ -193,6 +237,10 @@ class InterfaceLaw:
                              f"{type(committed).__name__}")
         jump = check_jump(jump, committed)
         n = jump.shape[0]
+        if shift is not None and shift.shape != (n, 2):
+            raise ValueError(f"multipliers hold {shift.shape[0]} points; the jump has {n}: "
+                             f"with_multipliers needs an (n, 3) array for the n = {n} points "
+                             "evaluated")
 
         h = self.h0 + jump[:, 0]
         traction = np.zeros((n, 3))
@@ -246,17 +294,20 @@ class InterfaceLaw:
                 kt[un] *= scale
                 dkt[un] *= scale
         if contact.all():  # work on views: no gather/scatter
-            pts_in = FrictionInput(jump[:, 1] - sp[:, 0], jump[:, 2] - sp[:, 1], cx * kt,
-                                   cy * kt, cx * dkt, cy * dkt, p, k, kap[:, 0], kap[:, 1],
-                                   committed.slip_path)
+            cols = (jump[:, 1] - sp[:, 0], jump[:, 2] - sp[:, 1], cx * kt, cy * kt, cx * dkt,
+                    cy * dkt, p, k, kap[:, 0], kap[:, 1], committed.slip_path)
+            pts_in = (FrictionInput(*cols) if shift is None
+                      else ShiftedFrictionInput(*cols, shift[:, 0], shift[:, 1]))
             slip = self.friction.evaluate(pts_in, traction[:, 1:], tangent[:, 1:, :])
             pts = slip.slip_index
         else:
             ic = np.flatnonzero(contact)
             kc, dkc = kt.take(ic), dkt.take(ic)
-            pts_in = FrictionInput(jump[ic, 1] - sp[ic, 0], jump[ic, 2] - sp[ic, 1], cx * kc,
-                                   cy * kc, cx * dkc, cy * dkc, p.take(ic), k.take(ic),
-                                   kap[ic, 0], kap[ic, 1], committed.slip_path.take(ic))
+            cols = (jump[ic, 1] - sp[ic, 0], jump[ic, 2] - sp[ic, 1], cx * kc, cy * kc,
+                    cx * dkc, cy * dkc, p.take(ic), k.take(ic), kap[ic, 0], kap[ic, 1],
+                    committed.slip_path.take(ic))
+            pts_in = (FrictionInput(*cols) if shift is None
+                      else ShiftedFrictionInput(*cols, shift[ic, 0], shift[ic, 1]))
             slip = self.friction.evaluate(pts_in)
             traction[ic, 1:] = slip.traction
             tangent[ic, 1:, :] = slip.tangent
@@ -277,3 +328,63 @@ class InterfaceLaw:
             state.h_min = h_min_new
         return LawResult(traction, tangent, state, dissipation, a, contact, slipping, beyond,
                          normal_dissipation)
+
+
+def _check_multipliers(multipliers) -> np.ndarray:
+    """The multipliers as a float (n, 3) array; ValueError naming what is wrong."""
+    try:
+        lam = np.asarray(multipliers, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"multipliers ({type(multipliers).__name__}) must be an (n, 3) array "
+                         "[lambda_N, lambda_x, lambda_y] [MPa]") from None
+    if lam.ndim != 2 or lam.shape[1] != 3:
+        raise ValueError(f"multipliers must have shape (n, 3) [lambda_N, lambda_x, lambda_y] "
+                         f"[MPa], got {lam.shape}")
+    finite = np.isfinite(lam)
+    if not finite.all():
+        bad = np.flatnonzero(~finite.all(axis=1))
+        raise ValueError(f"multipliers are not finite at {bad.size} of {lam.shape[0]} points "
+                         f"(first index {bad[0]}: {lam[bad[0]].tolist()} MPa); valid: finite")
+    if lam.shape[0] and lam[:, 0].min() < 0.0:
+        i = int(np.argmin(lam[:, 0]))
+        raise ValueError(f"multipliers[:, 0] (lambda_N, a contact pressure) = "
+                         f"{float(lam[i, 0])!r} MPa at point {i} is invalid: it must be >= 0")
+    return lam
+
+
+@dataclass(frozen=True)
+class ShiftedInterfaceLaw:
+    """An :class:`InterfaceLaw` with its friction trial traction shifted by the tangential
+    multipliers of n points: what ``InterfaceLaw.with_multipliers`` returns (the normal law is
+    the unshifted one; lambda_N is not used).
+
+    Attributes:
+        law: the plain law (with friction).
+        multipliers: (n, 3) [lambda_N, lambda_x, lambda_y] [MPa], checked by
+            ``with_multipliers``.
+    """
+
+    law: InterfaceLaw
+    multipliers: np.ndarray
+
+    def initial_state(self, n_pts: int) -> InterfaceState:
+        """Virgin history at n_pts points (that of the plain law)."""
+        return self.law.initial_state(n_pts)
+
+    def evaluate(self, jump: np.ndarray, committed: InterfaceState) -> LawResult:
+        """The law at ``jump`` (n, 3) with t_trial = lambda_T + K_T (s - s_p) (see
+        :meth:`InterfaceLaw.evaluate`; ValueError if the multipliers are not for n points)."""
+        return self.law._evaluate(jump, committed, self.multipliers[:, 1:])
+
+    def max_friction_coefficient(self) -> float:
+        """That of the plain law."""
+        return self.law.max_friction_coefficient()
+
+    @property
+    def has_normal_memory(self) -> bool:
+        """That of the plain law."""
+        return self.law.has_normal_memory
+
+    def normal_dissipated(self, state: InterfaceState) -> np.ndarray:
+        """That of the plain law."""
+        return self.law.normal_dissipated(state)

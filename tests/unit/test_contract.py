@@ -281,13 +281,14 @@ def test_newton_tangent_laws(gw_normal):
 
 
 def test_multiplier_laws(gw_normal):
-    """Only the Coulomb penalty declares the multiplier capability; the law it returns for
-    given multipliers follows the contract."""
+    """The Coulomb penalty and the rough law (its friction part, issue 22) declare the
+    multiplier capability, the linear penalty does not; the law the penalty returns for given
+    multipliers follows the contract (the rough law's: tests/unit/test_rough_multiplier.py)."""
     from rough_contact.interface.contract import MultiplierLaw
 
     laws = built_in_laws(gw_normal)
     assert [k for k, law in laws.items() if isinstance(law, MultiplierLaw)] == \
-        ["softplus_penalty"]
+        ["rough_ortho", "rough_ortho_k", "rough_iso", "rough_frictionless", "softplus_penalty"]
     plain = laws["softplus_penalty"]
     state = plain.initial_state(3)
     law = plain.with_multipliers(np.full((3, 3), 0.1))
