@@ -6,6 +6,7 @@ against (1 - Q/muP)^(1/3), the dissipation, Newton iterations.
         [--points nodal|quadrature] [--basis standard|dual] [--plain]
         [--enforcement uzawa|newton] [--residual-ratio 1e-2] [--contact-size 0.05]
         [--preload-steps 2] [--shear-steps 6] [--k-tangential 1e9] [--al-tol 1e-4] [--nu 0.49]
+        [--half-width 4] [--height 4] [--mesh-size 1] [--transition 1]
 
 ``--shear-steps 0`` runs the normal load alone. ``--enforcement newton`` updates the
 multipliers inside the Newton iteration (``NewtonAugmentedLagrangian``, nodal points only);
@@ -44,6 +45,13 @@ def main(argv=None):
                     "the multipliers converge")
     ap.add_argument("--al-tol", type=float, default=1e-4)
     ap.add_argument("--nu", type=float, default=0.49)
+    ap.add_argument("--half-width", type=float, default=4.0,
+                    help="block half width L [mm] (the half model is [-L, L] x [0, L] x [-H, 0])")
+    ap.add_argument("--height", type=float, default=4.0, help="block height H [mm]")
+    ap.add_argument("--mesh-size", type=float, default=1.0,
+                    help="element size away from the contact [mm]")
+    ap.add_argument("--transition", type=float, default=1.0,
+                    help="distance over which the element size grows to --mesh-size [mm]")
     ap.add_argument("--verbose", action="store_true")
     args = ap.parse_args(argv)
     newton = args.enforcement == "newton" and not args.plain
@@ -55,7 +63,9 @@ def main(argv=None):
                     augmented=not (args.plain or newton), enforcement=enforcement,
                     points=args.points, basis=args.basis,
                     augmentation_tolerance=args.al_tol, max_updates=60,
-                    k_tangential=args.k_tangential, verbose=args.verbose)
+                    k_tangential=args.k_tangential, half_width=args.half_width,
+                    height=args.height, mesh_size=args.mesh_size,
+                    transition=args.transition, verbose=args.verbose)
     E_star = E / (1.0 - args.nu**2)
     q = r.Q / (r.mu * r.P)
     PETSc.Sys.Print(f"{'t':>6} {'P [N]':>8} {'P/Hertz-1':>9} {'Q/muP':>7} {'c/a FE':>7} "

@@ -236,7 +236,10 @@ class MultiplierLaw(Protocol):
     The multipliers are (n, 3) ``[lambda_N, lambda_x, lambda_y]``: the contact pressure
     lambda_N >= 0 and the tangential traction the penalty is shifted by [MPa]. At the fixed
     point of the multiplier updates (lambda <- the converged tractions [p, t_x, t_y]) the
-    penalty's elastic gap and elastic slip vanish. The multipliers are kept by the interface's
+    constraints the law makes exact hold: for a Coulomb penalty (``SoftplusPenalty``) the
+    elastic gap and the elastic slip vanish; for the rough law (``InterfaceLaw``) only the
+    elastic slip does -- its normal pressure p(h) is the physical asperity compliance and is
+    not shifted (lambda_N unused). The multipliers are kept by the interface's
     history, not by the law state: a law with this capability is still an ordinary law (its
     ``evaluate`` is the unshifted penalty)."""
 
