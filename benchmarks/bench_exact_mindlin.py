@@ -7,6 +7,7 @@ against (1 - Q/muP)^(1/3), the dissipation, Newton iterations.
         [--enforcement uzawa|newton] [--residual-ratio 1e-2] [--contact-size 0.05]
         [--preload-steps 2] [--shear-steps 6] [--k-tangential 1e9] [--al-tol 1e-4] [--nu 0.49]
         [--half-width 4] [--height 4] [--mesh-size 1] [--transition 1]
+        [--refined-radius 0.4]
 
 ``--shear-steps 0`` runs the normal load alone. ``--enforcement newton`` updates the
 multipliers inside the Newton iteration (``NewtonAugmentedLagrangian``, nodal points only);
@@ -50,6 +51,8 @@ def main(argv=None):
     ap.add_argument("--height", type=float, default=4.0, help="block height H [mm]")
     ap.add_argument("--mesh-size", type=float, default=1.0,
                     help="element size away from the contact [mm]")
+    ap.add_argument("--refined-radius", type=float, default=0.4,
+                    help="radius about the origin meshed at --contact-size [mm]")
     ap.add_argument("--transition", type=float, default=1.0,
                     help="distance over which the element size grows to --mesh-size [mm]")
     ap.add_argument("--verbose", action="store_true")
@@ -65,7 +68,8 @@ def main(argv=None):
                     augmentation_tolerance=args.al_tol, max_updates=60,
                     k_tangential=args.k_tangential, half_width=args.half_width,
                     height=args.height, mesh_size=args.mesh_size,
-                    transition=args.transition, verbose=args.verbose)
+                    transition=args.transition, refined_radius=args.refined_radius,
+                    verbose=args.verbose)
     E_star = E / (1.0 - args.nu**2)
     q = r.Q / (r.mu * r.P)
     PETSc.Sys.Print(f"{'t':>6} {'P [N]':>8} {'P/Hertz-1':>9} {'Q/muP':>7} {'c/a FE':>7} "

@@ -2,6 +2,8 @@
 
     OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bench_mindlin.py [--levels 0.05 0.025]
         [--part stick|energy|all] [--amplitudes 0.5] [--ring 0.25 [--ring-band 0.8 1.05]]
+        [--exact --points nodal --basis dual] [--steps-per-cycle 16]
+        [--half-width 4 --height 4 --mesh-size 1 --transition 1]
 
 Rigid paraboloid R = 10 mm on a half block 8 x 4 x 4 mm, E = 200 GPa, nu = 0.49, mu = 0.3,
 Coulomb penalty 1e8 MPa/mm (normal and tangential), P2, bottom pushed up by 4 um (P ~ 294 N,
@@ -9,7 +11,8 @@ a ~ 0.20 mm), then slid along x. "stick": the FE stick ratio sqrt(1 - A_slip / A
 (1 - Q / mu P)^(1/3) at every increment of a monotonic slide to gross slip (12 increments).
 "energy": two triangle cycles of the slide (16 increments each) at amplitude x (the slide that
 reaches mu P): the interface dissipation of the second cycle and the loop area of Q against the
-bottom slide (trapezoids) against Mindlin–Deresiewicz at the measured amplitude Q*.
+bottom slide (trapezoids) against Mindlin–Deresiewicz at the measured amplitude Q*, and the
+second cycle's descending branch against Masing's (largest |Q - Q_Masing| / Q*).
 Units: mm, N, MPa.
 """
 
@@ -22,17 +25,21 @@ import numpy as np
 from petsc4py import PETSc
 
 from rough_contact import references
+from rough_contact.interface.enforcement import NewtonAugmentedLagrangian
 from rough_contact.scenes import mindlin
 
 E, NU, MU, R, DELTA = 2.0e5, 0.49, 0.3, 10.0, 4e-3
 
 
-def gross_slide():
+def gross_slide(half_width=4.0, height=4.0):
+    """The bottom slide at which Mindlin's Q reaches mu P (Hertz's P and a at DELTA) plus the
+    block's shear compliance H / (G 2 L^2) times mu P."""
     G = E / (2 * (1 + NU))
     Es = E / (1 - NU**2)
     P = references.hertz_force(DELTA, R, Es)
     a = references.hertz_radius(P, R, Es)
-    return references.sliding_approach(MU, P, a, G, NU) + MU * P * 4.0 / (G * 2 * 16.0)
+    return references.sliding_approach(MU, P, a, G, NU) + \
+        MU * P * height / (G * 2 * half_width * half_width)
 
 
 def _kt(h, kt, kt_scale):
@@ -56,20 +63,49 @@ def stick(levels, kt=None, kt_scale=None):
                             f"{int(r.newton.sum()):6d} {dt:6.0f}")
 
 
+def masing_error(r, G, block_compliance):
+    """Largest |Q_FE - Q_Masing| / Q* over the second cycle's descending branch (t in
+    [2.25, 2.75]): Masing's branch from the amplitude (s*, Q*) of the FE loop, Q(s) = Q* -
+    2 Q_v((s* - s) / 2), with the virgin curve Q_v(s) of Mindlin's closed form plus the block's
+    linear shear compliance s = delta(Q) + c_b Q (inverted by bisection)."""
+    P, a, mu = r.P[-1], r.a, r.mu
+    idx = np.flatnonzero((r.t > 2.25 + 1e-9) & (r.t < 2.75 - 1e-9))
+    top = int(np.argmin(np.abs(r.t - 2.25)))
+    s_top, Q_top = r.slide[top], r.Q[top]
+
+    def virgin(x):                      # Q at slide x >= 0 (bisection on [0, mu P])
+        lo, hi = np.zeros_like(x), np.full_like(x, mu * P)
+        for _ in range(60):
+            m = 0.5 * (lo + hi)
+            f = references.tangential_approach(m, mu, P, a, G, NU) + block_compliance * m
+            lo, hi = np.where(f < x, m, lo), np.where(f < x, hi, m)
+        return 0.5 * (lo + hi)
+
+    Q_ref = Q_top - 2.0 * virgin(0.5 * (s_top - r.slide[idx]))
+    return float(np.max(np.abs(r.Q[idx] - Q_ref)) / abs(Q_top)) if idx.size else float("nan")
+
+
 def energy(levels, amplitudes, kt=None, kt_scale=None, ring_size=None, ring_band=(0.8, 1.05),
-           width_ratio=1e-3, augmented=False, quadrature_degree=None, verbose=False):
+           width_ratio=1e-3, augmented=False, quadrature_degree=None, verbose=False,
+           steps_per_cycle=16, scene=None):
+    """``scene``: further arguments of ``mindlin.run`` (block, mesh, points, enforcement)."""
+    scene = dict(scene or {})
     PETSc.Sys.Print(f"{'h':>6} {'DOFs':>7} {'ampl':>5} {'Q*/muP':>6} {'W FE':>10} {'loop':>10} "
-                    f"{'W MD':>10} {'error':>7} {'Newton':>6} {'time s':>6}")
+                    f"{'W MD':>10} {'error':>7} {'Masing':>7} {'Newton':>6} {'time s':>6} "
+                    f"{'CPU s':>6}")
     G = E / (2 * (1 + NU))
+    L, H = scene.get("half_width", 4.0), scene.get("height", 4.0)
+    c_b = H / (G * 2.0 * L * L)         # the block's shear compliance [mm/N]
     for h in levels:
         for amp in amplitudes:
-            t0 = time.perf_counter()
-            r = mindlin.run(contact_size=h, order=2, nu=NU, mu=MU, slide=amp * gross_slide(),
-                            cycles=2, shear_steps=16, k_tangential=_kt(h, kt, kt_scale),
+            t0, c0 = time.perf_counter(), time.process_time()
+            r = mindlin.run(contact_size=h, order=2, nu=NU, mu=MU,
+                            slide=amp * gross_slide(L, H), cycles=2,
+                            shear_steps=steps_per_cycle, k_tangential=_kt(h, kt, kt_scale),
                             ring_size=None if ring_size is None else h * ring_size,
                             ring_band=tuple(ring_band), width_ratio=width_ratio,
                             augmented=augmented, quadrature_degree=quadrature_degree,
-                            verbose=verbose)
+                            verbose=verbose, **scene)
             t, s, Q, D = r.t, r.slide, r.Q, r.dissipation
             end1 = int(np.argmin(np.abs(t - 2.0)))
             idx = np.arange(end1, t.size)
@@ -79,7 +115,8 @@ def energy(levels, amplitudes, kt=None, kt_scale=None, ring_size=None, ring_band
             ref = float(references.energy_per_cycle(Qs, MU, r.P[-1], r.a, G, NU))
             PETSc.Sys.Print(f"{h:6.4f} {r.dofs:7d} {amp:5.2f} {Qs / (MU * r.P[-1]):6.3f} "
                             f"{W:10.4e} {loop:10.4e} {ref:10.4e} {W / ref - 1:+7.3f} "
-                            f"{int(r.newton.sum()):6d} {time.perf_counter() - t0:6.0f}")
+                            f"{masing_error(r, G, c_b):7.4f} {int(r.newton.sum()):6d} "
+                            f"{time.perf_counter() - t0:6.0f} {time.process_time() - c0:6.0f}")
 
 
 def main(argv=None):
@@ -104,6 +141,19 @@ def main(argv=None):
     ap.add_argument("--quadrature-degree", type=int, default=None,
                     help="energy: facet Gauss rule degree (default 2 x order = 4; 1 = one point "
                     "per facet, the rule the augmented Lagrangian converges with on P2)")
+    ap.add_argument("--steps-per-cycle", type=int, default=16,
+                    help="energy: increments per cycle (a multiple of 4)")
+    ap.add_argument("--points", default="quadrature", choices=["quadrature", "nodal"])
+    ap.add_argument("--basis", default="standard", choices=["standard", "dual"])
+    ap.add_argument("--exact", action="store_true",
+                    help="energy: exact contact and stick by multipliers updated inside "
+                    "Newton (NewtonAugmentedLagrangian(--al-tol); needs --points nodal)")
+    ap.add_argument("--al-tol", type=float, default=1e-4)
+    ap.add_argument("--half-width", type=float, default=4.0, help="block half width L [mm]")
+    ap.add_argument("--height", type=float, default=4.0, help="block height H [mm]")
+    ap.add_argument("--mesh-size", type=float, default=1.0, help="far element size [mm]")
+    ap.add_argument("--transition", type=float, default=1.0,
+                    help="distance over which the element size grows to --mesh-size [mm]")
     ap.add_argument("--verbose", action="store_true",
                     help="energy: print every increment (Newton iterations, multiplier updates, "
                     "cutbacks)")
@@ -111,9 +161,14 @@ def main(argv=None):
     if args.part in ("stick", "all"):
         stick(args.levels, args.k_tangential, args.kt_scale)
     if args.part in ("energy", "all"):
+        scene = dict(half_width=args.half_width, height=args.height,
+                     mesh_size=args.mesh_size, transition=args.transition,
+                     points=args.points, basis=args.basis)
+        if args.exact:
+            scene["enforcement"] = NewtonAugmentedLagrangian(args.al_tol, 60)
         energy(args.levels, args.amplitudes, args.k_tangential, args.kt_scale, args.ring,
                args.ring_band, args.width_ratio, args.augmented, args.quadrature_degree,
-               args.verbose)
+               args.verbose, args.steps_per_cycle, scene)
 
 
 if __name__ == "__main__":

@@ -105,7 +105,7 @@ class MindlinRun:
         stick: FE stick ratio sqrt(1 - A_slip / A_contact) [-] (nan without contact).
         contact_area: nominal area with p > 1e-3 p_max (whole contact) [mm^2].
         dissipation: committed dissipation (whole contact) [N mm].
-        newton: Newton iterations spent up to each increment.
+        newton: Newton iterations spent on each increment.
         a: Hertz's contact radius at the final P [mm].
         G: shear modulus [MPa]; nu: Poisson ratio; mu: friction coefficient.
         dofs: global number of DOFs.
@@ -135,6 +135,7 @@ def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5
         shear_steps=12, cycles=0, indenter="paraboloid", quadrature_degree=None,
         k_tangential=None, ring_size=None, ring_band=(0.8, 1.05), width_ratio=1e-3,
         augmented=False, augmentation_tolerance=1e-3, points="quadrature", transition=1.0,
+        refined_radius=0.4,
         max_updates=30, basis="standard", enforcement=None, comm=MPI.COMM_WORLD,
         verbose=False) -> MindlinRun:
     """Normal indentation by ``delta`` [mm], then a tangential bottom displacement: monotonic to
@@ -157,10 +158,11 @@ def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5
     Q/mu P = 0.15, a ring 0.05 a wide); default: no ring, ``contact_size`` everywhere in the
     contact. The tangential penalty keeps its ``contact_size`` scaling.
 
-    ``half_width``, ``height``, ``mesh_size``, ``transition`` [mm]: the block and its mesh
-    (``indented_block``): the element size grows from ``contact_size`` (within 0.4 mm of the
-    axis) to ``mesh_size`` over ``transition``. A larger block needs a proportionally longer
-    transition (a gentle grading), else its coarse far mesh stiffens the answer.
+    ``half_width``, ``height``, ``mesh_size``, ``transition``, ``refined_radius`` [mm]: the
+    block and its mesh (``indented_block``): the element size grows from ``contact_size``
+    (within ``refined_radius`` of the origin) to ``mesh_size`` over ``transition``. A larger
+    block needs a proportionally longer transition (a gentle grading), else its coarse far
+    mesh stiffens the answer (docs/mindlin_dual.md, "A large block").
 
     ``width_ratio``: the softplus smoothing length as a fraction of ``delta``. The smoothed law
     carries a pressure k w ln 2 at zero gap (w = width_ratio delta; 8 % of Hertz's p0 at the
@@ -219,7 +221,8 @@ def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5
         a_h = np.sqrt(radius * delta)
         ring = (0.5 * (lo + hi) * a_h, 0.5 * (hi - lo) * a_h, ring_size)
     scene = indented_block(half_width=half_width, height=height, mesh_size=mesh_size,
-                           contact_size=contact_size, transition=transition, order=order, half=True,
+                           contact_size=contact_size, transition=transition,
+                           refined_radius=refined_radius, order=order, half=True,
                            ring=ring, comm=comm)
     V = vector_space(scene.mesh, order)
     sym = fix(V, scene.facet_tags, scene.tag("symmetry_y"), 1)
