@@ -104,7 +104,7 @@ def _run(law, enforcement, comm):
         slipping=gather(pf.slipping)[order],
         kappa=gather(ci.history.law.committed.slip_path)[order],
         dissipation=ci.summary().dissipation,
-        updates=c.allreduce(getattr(ci, "newton_updates", 0), op=MPI.MAX))
+        updates=c.allreduce(ci.newton_updates, op=MPI.MAX))
     solver.destroy()
     return out
 
