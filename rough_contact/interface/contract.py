@@ -243,8 +243,13 @@ class MultiplierLaw(Protocol):
     history, not by the law state: a law with this capability is still an ordinary law (its
     ``evaluate`` is the unshifted penalty)."""
 
-    def with_multipliers(self, multipliers: np.ndarray) -> InterfaceLawProtocol:
-        """The law with its penalty shifted by ``multipliers`` (n, 3) [MPa]: an object with the
+    def with_multipliers(self, multipliers: np.ndarray,
+                         stiffness_factor: float = 1.0) -> InterfaceLawProtocol:
+        """The law with its penalty shifted by ``multipliers`` (n, 3) [MPa], and the penalty the
+        multipliers are augmented with multiplied by ``stiffness_factor`` (> 0; 1: the law's
+        own; the fixed point does not depend on it, the rate of the updates does: about
+        K_b / (K_b + factor x penalty) per update, K_b the stiffness a point sees from the
+        bodies): an object with the
         same ``initial_state``/``evaluate`` (and ``newton_tangent``, if the law has one) for
         those n points; cheap to create (no copy of the arrays)."""
         ...

@@ -108,14 +108,22 @@ class AugmentedLagrangian:
             accurate to rtol 1e-9 of the step's first residual, and the changes stall there.
         max_updates: multiplier updates per load increment (>= 1) before the increment counts
             as not converged (cutback).
+        stiffness_factor: the law's penalty under the multipliers is multiplied by this (> 0)
+            (``MultiplierLaw.with_multipliers``): the fixed point does not depend on it, the
+            rate of the updates does (about K_b / (K_b + factor x penalty) per update). 1 (the
+            default) for a penalty law whose stiffness the user chose (``SoftplusPenalty``);
+            for the rough law, whose tangential stiffness K_T = c k_N is the physical and soft
+            one, 10-100 (docs/exact_contact.md).
     """
 
     tolerance: float = 1e-3
     max_updates: int = 30
+    stiffness_factor: float = 1.0
     name: str = "augmented_lagrangian"
 
     def __post_init__(self) -> None:
         check_scalar("augmentation tolerance", self.tolerance, lo=0.0, hi=1.0, hi_open=True)
+        check_scalar("stiffness_factor", self.stiffness_factor, lo=0.0)
         if (not isinstance(self.max_updates, (int, np.integer))
                 or isinstance(self.max_updates, bool) or self.max_updates < 1):
             raise ValueError(f"max_updates = {self.max_updates!r} is invalid: it must be an "
@@ -134,8 +142,8 @@ class AugmentedLagrangian:
         return np.zeros((int(n_points), 3))
 
     def law_for(self, law: MultiplierLaw, multipliers: np.ndarray) -> InterfaceLawProtocol:
-        """The law shifted by ``multipliers``."""
-        return law.with_multipliers(multipliers)
+        """The law shifted by ``multipliers`` (its penalty times ``stiffness_factor``)."""
+        return law.with_multipliers(multipliers, self.stiffness_factor)
 
     @staticmethod
     def update(multipliers: np.ndarray, result: LawResult) -> MultiplierUpdate:
@@ -182,8 +190,9 @@ class NewtonAugmentedLagrangian(AugmentedLagrangian):
     (``rough_contact.solver.snes.NewtonIterationHook``).
 
     Args:
-        tolerance, max_updates: as :class:`AugmentedLagrangian` (``max_updates`` bounds the
-            re-solves after a converged Newton solve, not the in-Newton updates).
+        tolerance, max_updates, stiffness_factor: as :class:`AugmentedLagrangian`
+            (``max_updates`` bounds the re-solves after a converged Newton solve, not the
+            in-Newton updates).
         first_iteration: the first Newton iterate (>= 0) at which the multipliers are updated
             (0: also at the start of a solve, the predicted start or, in a re-solve, the
             iterate ``accept`` has just updated them at).

@@ -188,13 +188,20 @@ class InterfaceLaw:
             return np.zeros(len(state))
         return np.asarray(self.normal.normal_dissipation(state.h_min), dtype=float)
 
-    def with_multipliers(self, multipliers: np.ndarray) -> InterfaceLawProtocol:
+    def with_multipliers(self, multipliers: np.ndarray,
+                         stiffness_factor: float = 1.0) -> InterfaceLawProtocol:
         """The law with its friction trial traction shifted by the tangential multipliers
         (``rough_contact.interface.contract.MultiplierLaw``; see the class).
 
         Args:
             multipliers: (n, 3) [lambda_N, lambda_x, lambda_y] [MPa], finite, lambda_N >= 0
                 (lambda_N is not used: the normal law stays the unshifted p(h)).
+            stiffness_factor: (> 0) the shifted law's tangential stiffness is factor x K_T:
+                t_trial = lambda_T + factor K_T(h) (s - s_p). The fixed point (s = s_p at
+                sticking points) does not depend on it; the updates converge by about
+                K_b / (K_b + factor K_T) each (K_b: the stiffness a point sees from the
+                bodies), and the rough law's K_T is soft: 10-100 is the useful range
+                (docs/exact_contact.md). The normal law is never scaled.
 
         Returns:
             A :class:`ShiftedInterfaceLaw` for those n points; the law itself when it is
@@ -204,9 +211,10 @@ class InterfaceLaw:
             ValueError: ``multipliers`` not (n, 3), not finite, or lambda_N < 0.
         """
         lam = _check_multipliers(multipliers)
+        f = check_scalar("stiffness_factor", stiffness_factor, lo=0.0)
         if self.friction is None:
             return self
-        return ShiftedInterfaceLaw(self, lam)
+        return ShiftedInterfaceLaw(self, lam, f)
 
     def evaluate(self, jump: np.ndarray, committed: InterfaceState) -> LawResult:
         """Traction, consistent tangent and trial state at jump (n, 3) [mm]; never mutates input.
@@ -226,9 +234,10 @@ class InterfaceLaw:
         return self._evaluate(jump, committed, None)
 
     def _evaluate(self, jump: np.ndarray, committed: InterfaceState,
-                  shift: Optional[np.ndarray]) -> LawResult:
+                  shift: Optional[np.ndarray], stiffness_factor: float = 1.0) -> LawResult:
         """``evaluate`` with the friction trial traction shifted by ``shift`` (n, 2) [MPa]
-        (None: the plain law)."""
+        (None: the plain law) and the tangential stiffness multiplied by ``stiffness_factor``
+        (only with a shift)."""
         if self.h0 is None:
             raise ValueError("h0 (reference separation [mm]) is not set: pass h0= or use "
                              "with_seating(p_seat)")
@@ -281,6 +290,8 @@ class InterfaceLaw:
                              slipping, beyond, normal_dissipation)
 
         cx, cy = self.tangential.kt_over_kn
+        if shift is not None and stiffness_factor != 1.0:
+            cx, cy = cx * stiffness_factor, cy * stiffness_factor
         sp = committed.plastic_slip
         kap = committed.accumulated_slip
         kt, dkt = k, dk         # k_T / c and its h-derivative
@@ -362,10 +373,12 @@ class ShiftedInterfaceLaw:
         law: the plain law (with friction).
         multipliers: (n, 3) [lambda_N, lambda_x, lambda_y] [MPa], checked by
             ``with_multipliers``.
+        stiffness_factor: the shifted law's K_T is this times the law's (> 0).
     """
 
     law: InterfaceLaw
     multipliers: np.ndarray
+    stiffness_factor: float = 1.0
 
     def initial_state(self, n_pts: int) -> InterfaceState:
         """Virgin history at n_pts points (that of the plain law)."""
@@ -374,7 +387,8 @@ class ShiftedInterfaceLaw:
     def evaluate(self, jump: np.ndarray, committed: InterfaceState) -> LawResult:
         """The law at ``jump`` (n, 3) with t_trial = lambda_T + K_T (s - s_p) (see
         :meth:`InterfaceLaw.evaluate`; ValueError if the multipliers are not for n points)."""
-        return self.law._evaluate(jump, committed, self.multipliers[:, 1:])
+        return self.law._evaluate(jump, committed, self.multipliers[:, 1:],
+                                  self.stiffness_factor)
 
     def max_friction_coefficient(self) -> float:
         """That of the plain law."""

@@ -149,10 +149,17 @@ class SoftplusPenalty:
         """Virgin history (no plastic slip) at n_pts points."""
         return InterfaceState.zeros(n_pts)
 
-    def with_multipliers(self, multipliers: np.ndarray) -> ShiftedSoftplusPenalty:
+    def with_multipliers(self, multipliers: np.ndarray,
+                         stiffness_factor: float = 1.0) -> ShiftedSoftplusPenalty:
         """The law with its penalty shifted by ``multipliers`` (n, 3) [MPa]
-        (``rough_contact.interface.contract.MultiplierLaw``)."""
-        return ShiftedSoftplusPenalty(self, multipliers)
+        (``rough_contact.interface.contract.MultiplierLaw``); ``stiffness_factor`` != 1: the
+        shifted law has k_N and k_T multiplied by it and the width divided by it (p(0) kept),
+        as :meth:`softened` with 1 / factor."""
+        f = check_scalar("stiffness_factor", stiffness_factor, lo=0.0)
+        law = self if f == 1.0 else replace(self, k_normal=self.k_normal * f,
+                                            width=self.width / f,
+                                            k_tangential=self.k_tangential * f)
+        return ShiftedSoftplusPenalty(law, multipliers)
 
     def softened(self, factor: float) -> SoftplusPenalty:
         """The law with k_N and k_T divided by ``factor`` >= 1 and the width multiplied by it

@@ -354,15 +354,18 @@ def test_release_limit_with_shift():
                                rtol=1e-12)
 
 
+@pytest.mark.parametrize("factor", [1.0, 10.0], ids=["own_kt", "kt_x10"])
 @pytest.mark.parametrize("kb_over_kt,drive", [(0.5, 0.6), (4.0, 0.6), (1.0, 1.5)],
                          ids=["soft_body_stick", "stiff_body_stick", "slip"])
-def test_spring_in_series_converges_to_rigid_stick(kb_over_kt, drive):
+def test_spring_in_series_converges_to_rigid_stick(kb_over_kt, drive, factor):
     """One interface point in series with a body spring K_b pulled by a displacement U
     (tangential balance K_b (U - s) = t_x(s) at a fixed normal gap), solved exactly per
     multiplier update (bisection: t_x is monotone in s), lambda <- t by the enforcement's
     update. Penalty: s = K_b U / (K_b + K_T) (the rough law's compliance). Exact stick: the
     lambda error falls by K_b / (K_b + K_T) per update and s -> s_p = 0, t_x = K_b U; in slip
-    t_x -> mu p and the slip is all plastic. The pressure is p(h) throughout."""
+    t_x -> mu p and the slip is all plastic. The pressure is p(h) throughout. With the
+    enforcement's stiffness factor f the shifted law's K_T is f K_T: the same fixed point,
+    reached at the rate K_b / (K_b + f K_T)."""
     law = InterfaceLaw(ExponentialNormal(), TS, ORTHO, h0=1e-3)
     g = -2e-4
     p, k, _ = law.normal.evaluate(np.array([law.h0 + g]))
@@ -383,8 +386,9 @@ def test_spring_in_series_converges_to_rigid_stick(kb_over_kt, drive):
     s_pen, r_pen = solve(law)
     lam = np.zeros((1, 3))
     errs = []
-    for _ in range(int(np.log(1e-12) / np.log(kb / (kb + kt))) + 5):
-        s, r = solve(law.with_multipliers(lam))
+    rate_expected = kb / (kb + factor * kt)
+    for _ in range(int(np.log(1e-12) / np.log(rate_expected)) + 5):
+        s, r = solve(law.with_multipliers(lam, factor))
         np.testing.assert_array_equal(r.traction[:, 0], -p)      # normal untouched
         update = AugmentedLagrangian.update(lam, r)
         lam = update.multipliers
@@ -394,13 +398,14 @@ def test_spring_in_series_converges_to_rigid_stick(kb_over_kt, drive):
         np.testing.assert_allclose(s_pen, kb * U / (kb + kt), rtol=1e-10)
         assert not r_pen.slipping[0] and not r.slipping[0]
         # geometric convergence with the ratio K_b / (K_b + K_T) (the change of the updates)
-        rate = np.array(errs[2:8]) / np.array(errs[1:7])
-        np.testing.assert_allclose(rate, kb / (kb + kt), rtol=1e-6)
+        n = 5 if factor == 1.0 else 3     # the changes reach round-off sooner at x10
+        rate = np.array(errs[2:2 + n]) / np.array(errs[1:1 + n])
+        np.testing.assert_allclose(rate, rate_expected, rtol=1e-6)
         assert abs(s) <= 1e-9 * s_pen                          # rigid stick
         np.testing.assert_allclose(r.traction[0, 1], kb * U, rtol=1e-9)
     else:
         assert r.slipping[0]
-        assert abs(kt * e_el) <= 1e-9 * abs(r.traction[0, 1])   # slip all plastic
+        assert abs(factor * kt * e_el) <= 1e-9 * abs(r.traction[0, 1])   # all plastic
         mu_x = ORTHO.coefficients(r.state.accumulated_slip)[0][0, 0]
         np.testing.assert_allclose(r.traction[0, 1], mu_x * p[0], rtol=1e-10)
 
@@ -426,3 +431,45 @@ def test_multipliers_for_other_points():
     shifted = law.with_multipliers(np.zeros((5, 3)))
     with pytest.raises(ValueError, match=r"multipliers hold 5 points; the jump has 3"):
         shifted.evaluate(np.zeros((3, 3)), law.initial_state(3))
+
+
+@pytest.mark.parametrize("factor", [0.0, -1.0, np.nan, "x"])
+def test_bad_stiffness_factor(factor):
+    """A stiffness factor that is not a positive number is refused, naming it."""
+    law = InterfaceLaw(ExponentialNormal(), TS, ORTHO, h0=1e-3)
+    with pytest.raises((ValueError, TypeError), match="stiffness_factor"):
+        law.with_multipliers(np.zeros((2, 3)), factor)
+    with pytest.raises((ValueError, TypeError), match="stiffness_factor"):
+        AugmentedLagrangian(stiffness_factor=factor)
+
+
+@pytest.mark.parametrize("regime", ["stick", "slip", "mixed"])
+def test_stiffness_factor_is_the_law_with_a_stiffer_kt(regime):
+    """The shifted law with the stiffness factor f = 7 is the same law built with c x 7 and
+    shifted with factor 1 (an independent construction: traction, tangent and state equal to
+    round-off), its normal part is the unscaled law's, and its tangent matches central
+    differences."""
+    f = 7.0
+    law = InterfaceLaw(ExponentialNormal(), TS, ORTHO, h0=1e-3)
+    ref = InterfaceLaw(ExponentialNormal(),
+                       TangentialStiffness(tuple(f * c for c in TS.kt_over_kn)), ORTHO,
+                       h0=1e-3)
+    rng = np.random.default_rng(7)
+    n = 400
+    st = random_state(rng, n)
+    scale = {"stick": 1e-8, "slip": 3e-4, "mixed": 3e-5}[regime]
+    size = {"stick": 0.9, "slip": 3.0, "mixed": 1.2}[regime]
+    jump = np.column_stack([rng.uniform(-1e-3, 1e-3, n),
+                            st.plastic_slip + rng.normal(size=(n, 2)) * scale])
+    lam = multipliers_for(law, jump, rng, size)
+    shifted = law.with_multipliers(lam, f)
+    r, r_ref = shifted.evaluate(jump, st), ref.with_multipliers(lam).evaluate(jump, st)
+    np.testing.assert_allclose(r.traction, r_ref.traction, rtol=1e-14, atol=0)
+    np.testing.assert_allclose(r.tangent, r_ref.tangent, rtol=1e-13, atol=0)
+    np.testing.assert_allclose(r.state.plastic_slip, r_ref.state.plastic_slip, rtol=1e-14,
+                               atol=0)
+    np.testing.assert_array_equal(r.traction[:, 0], law.evaluate(jump, st).traction[:, 0])
+    keep = np.abs(trial_ratio(ref, jump, st, lam[:, 1:]) - 1.0) > 1e-4
+    frac = r.slipping[keep].mean()
+    assert {"stick": frac == 0.0, "slip": frac > 0.97, "mixed": 0.1 < frac < 0.9}[regime], frac
+    _fd_check(shifted, jump, st, keep)
