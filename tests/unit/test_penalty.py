@@ -312,3 +312,24 @@ def test_softened_law():
     for bad in (0.5, float("nan"), "10"):
         with pytest.raises(ValueError, match="softening factor"):
             law.softened(bad)
+
+
+def test_stiffness_factor_scales_the_shifted_penalty():
+    """with_multipliers(lambda, f) is the penalty with k_N, k_T x f and the width / f, shifted
+    (the same law built directly), and f = 1 is the law's own; a bad factor is refused."""
+    law = SoftplusPenalty(1e4, 1e-3, k_tangential=5e3, friction=0.3)
+    rng = np.random.default_rng(5)
+    n = 50
+    jump = np.column_stack([rng.uniform(-2e-3, 1e-3, n), rng.normal(0, 1e-3, (n, 2))])
+    st = law.initial_state(n)
+    lam = np.column_stack([rng.uniform(0, 5, n), rng.normal(0, 1, (n, 2))])
+    built = SoftplusPenalty(3e4, 1e-3 / 3, k_tangential=1.5e4, friction=0.3)
+    r = law.with_multipliers(lam, 3.0).evaluate(jump, st)
+    r_ref = built.with_multipliers(lam).evaluate(jump, st)
+    np.testing.assert_allclose(r.traction, r_ref.traction, rtol=1e-13, atol=1e-12)
+    np.testing.assert_allclose(r.tangent, r_ref.tangent, rtol=1e-13, atol=1e-9)
+    r1 = law.with_multipliers(lam).evaluate(jump, st)
+    np.testing.assert_array_equal(law.with_multipliers(lam, 1.0).evaluate(jump, st).traction,
+                                  r1.traction)
+    with pytest.raises(ValueError, match="stiffness_factor"):
+        law.with_multipliers(lam, 0.0)
