@@ -157,6 +157,27 @@ def form_sparsity(a, V) -> tuple[np.ndarray, np.ndarray]:
     return rows, cols
 
 
+def scalar_csr(local_rows: np.ndarray, global_cols: np.ndarray, n_rows: int, bs: int,
+               dtype=np.int64) -> tuple[np.ndarray, np.ndarray]:
+    """The scalar CSR (indptr, indices) of a node-level pattern with block size ``bs``: node
+    entry (r, c) becomes the bs x bs block of scalar rows bs r + i and columns bs c + j.
+
+    ``local_rows`` (sorted), ``global_cols``: the node pattern's entries (rows 0..n_rows-1).
+    Every scalar row of node row r repeats the same bs k_r columns (k_r: the node row's
+    entries), so the indices are one gather of the expanded columns (one pass over the
+    output, in ``dtype``; PETSc's integer type when it is 32-bit)."""
+    counts = np.bincount(local_rows, minlength=n_rows)
+    starts_n = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(dtype)
+    seg = (bs * global_cols.astype(dtype)[:, None] + np.arange(bs, dtype=dtype)).ravel()
+    lens = np.repeat((bs * counts).astype(dtype), bs)          # per scalar row
+    indptr = np.zeros(lens.size + 1, dtype=dtype)
+    np.cumsum(lens, out=indptr[1:])
+    # output position q of scalar row (r, i) reads seg[bs starts_n[r] + q - indptr[bs r + i]]
+    shift = np.repeat(bs * np.repeat(starts_n, bs) - indptr[:-1], lens)
+    shift += np.arange(indptr[-1], dtype=dtype)
+    return indptr, seg[shift]
+
+
 def block_csr_matrix(V, local_rows: np.ndarray, global_cols: np.ndarray):
     """A preallocated PETSc AIJ matrix of ``V``'s layout (block size 3) whose node-level
     pattern is the (sorted, unique) entries (local_rows, global_cols), with dolfinx's
@@ -166,19 +187,11 @@ def block_csr_matrix(V, local_rows: np.ndarray, global_cols: np.ndarray):
     imap = V.dofmap.index_map
     bs = V.dofmap.index_map_bs
     n_loc, n_glob = imap.size_local, imap.size_global
-    indptr_n = np.concatenate([[0], np.cumsum(np.bincount(local_rows, minlength=n_loc))])
-    # expand the node pattern to scalar rows: row bs*r+i has cols bs*c+j, c in row r
-    seg = (bs * global_cols[:, None] + np.arange(bs)).ravel()
-    L = bs * np.diff(indptr_n)
-    lens = np.repeat(L, bs)
-    indptr = np.concatenate([[0], np.cumsum(lens)])
-    within = np.arange(indptr[-1]) - np.repeat(indptr[:-1], lens)
-    start = np.repeat(np.repeat(bs * indptr_n[:-1], bs), lens)
-    indices = seg[start + within]
+    indptr, indices = scalar_csr(local_rows, global_cols, n_loc, bs, PETSc.IntType)
     A = PETSc.Mat().create(comm=V.mesh.comm)
     A.setSizes(((bs * n_loc, bs * n_glob), (bs * n_loc, bs * n_glob)), bsize=bs)
     A.setType(PETSc.Mat.Type.AIJ)
-    A.setPreallocationCSR((indptr.astype(PETSc.IntType), indices.astype(PETSc.IntType)))
+    A.setPreallocationCSR((indptr, indices))
     l2g = np.concatenate(
         [np.arange(*imap.local_range, dtype=np.int64), np.asarray(imap.ghosts, dtype=np.int64)])
     lgmap = PETSc.LGMap().create(l2g.astype(PETSc.IntType), bsize=bs, comm=MPI.COMM_SELF)
