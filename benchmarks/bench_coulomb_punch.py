@@ -15,15 +15,20 @@ relative to the largest traction (about 1 for a penalty, the tolerance for exact
         [--quadrature gauss vertex nodal] [--reversal-stiffness 0 1] [--augmented 0 1 2]
         [--al-tol 1e-3] [--basis standard dual] [--residual-ratio 1e-2]
         [--continuation none 100,10] [--after 10] [--linear-solver auto mumps hypre] [--csv FILE]
+        [--mesh-size H] [--contact-size HC]
 
 Levels (P1; mesh and contact size in LEVELS): 1 ~4.5 k DOFs, 2 ~26 k, 3 ~73 k, 4 ~99 k (the size
-of GetFEM's finest run).
+of GetFEM's finest run). ``--mesh-size`` (bulk element size, (0, 50] mm) and ``--contact-size``
+(element size on the contact patch, (0, min(mesh size, 10)] mm) replace the level's sizes, for
+refining the bulk and the contact separately (docs/punch_refinement.md); every row shows the
+sizes used, the DOFs and the vertices of the punch's contact face.
 Units: mm, N, MPa.
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 import time
 
@@ -36,6 +41,7 @@ import numpy as np  # noqa: E402
 from mpi4py import MPI  # noqa: E402
 from petsc4py import PETSc  # noqa: E402
 
+from rough_contact.fem.mesh import facet_vertex_coordinates
 from rough_contact.fem.nodal import NodalContactInterface
 from rough_contact.interface.enforcement import (AugmentedLagrangian, NewtonAugmentedLagrangian,
                                                  Penalty)
@@ -47,13 +53,40 @@ from rough_contact.solver.snes import Continuation
 # (mesh size, contact size) [mm]
 LEVELS = {1: (10.0, 0.7), 2: (5.0, 0.3), 3: (3.3, 0.2), 4: (3.3, 0.165)}
 N_LOAD = 16
+FOUNDATION_HALF_WIDTH = 50.0   # [mm]: the largest mesh size that means anything
+PUNCH_HALF_WIDTH = 10.0        # [mm]: the largest contact size (one element across the face)
+
+
+def level_sizes(level: int, mesh_size=None, contact_size=None) -> tuple:
+    """(mesh size, contact size) [mm] of ``level`` (LEVELS), either replaced when given.
+    Raises ValueError naming the option, its value and the valid range."""
+    h, hc = LEVELS[level]
+    h = h if mesh_size is None else mesh_size
+    hc = hc if contact_size is None else contact_size
+    if not (math.isfinite(h) and 0.0 < h <= FOUNDATION_HALF_WIDTH):
+        raise ValueError(f"--mesh-size = {h!r} mm is invalid: valid range (0, "
+                         f"{FOUNDATION_HALF_WIDTH:g}] mm (the foundation's half width)")
+    top = min(h, PUNCH_HALF_WIDTH)
+    if not (math.isfinite(hc) and 0.0 < hc <= top):
+        raise ValueError(f"--contact-size = {hc!r} mm is invalid: valid range (0, {top:g}] mm "
+                         f"(at most the mesh size, {h:g} mm"
+                         + (f", of level {level}" if mesh_size is None else "")
+                         + f", and the punch's half width, {PUNCH_HALF_WIDTH:g} mm)")
+    return h, hc
+
+
+def contact_vertices(scene, comm) -> int:
+    """Global number of vertices of the punch's contact face (the first contact surface)."""
+    xyz = facet_vertex_coordinates(scene, scene.contact_pair[0]).reshape(-1, 3)
+    allxyz = np.concatenate(comm.allgather(xyz))
+    return len(np.unique(np.round(allxyz, 9), axis=0))
 
 
 def run(level: int, mu: float, k: float, width: float, predictor: str, quadrature="gauss",
         comm=MPI.COMM_WORLD, verbose=False, reversal_stiffness=1.0, augmented=False,
         al_tol=1e-3, continuation=None, linear_solver="auto", residual_ratio=1e-2,
-        basis="standard") -> dict:
-    mesh_size, contact_size = LEVELS[level]
+        basis="standard", mesh_size=None, contact_size=None) -> dict:
+    mesh_size, contact_size = level_sizes(level, mesh_size, contact_size)
     law = SoftplusPenalty(k_normal=k, width=width, k_tangential=k, friction=mu,
                           reversal_stiffness=reversal_stiffness)
     if augmented == 2:     # multipliers updated inside the Newton iteration (nodal points)
@@ -86,7 +119,9 @@ def run(level: int, mu: float, k: float, width: float, predictor: str, quadratur
     cpu = comm.allreduce(time.process_time() - t0, op=MPI.SUM)
     peak = next((i for i in incs if i.load_factor == 1.0), None)
     cont = m.solver.continuation
-    out = dict(level=level, dofs=m.problem.num_dofs, points=m.interface.n_points_global, mu=mu,
+    out = dict(level=level, mesh_size=mesh_size, contact_size=contact_size,
+               dofs=m.problem.num_dofs, vertices=contact_vertices(m.scene, comm),
+               points=m.interface.n_points_global, mu=mu,
                k=k, predictor=predictor, quadrature=quadrature,
                reversal_stiffness=reversal_stiffness, augmented=augmented, al_tol=al_tol,
                continuation=("none" if cont is None else
@@ -158,11 +193,25 @@ def main(argv=None):
     ap.add_argument("--linear-solver", nargs="+", default=["auto"],
                     help="SNESSolver linear_solver: auto (MUMPS up to the DOF threshold), "
                          "mumps, hypre, ...")
+    ap.add_argument("--mesh-size", type=float, default=None,
+                    help="bulk element size [mm], replacing the level's (LEVELS); (0, 50]")
+    ap.add_argument("--contact-size", type=float, default=None,
+                    help="element size on the contact patch [mm], replacing the level's; "
+                    "(0, min(mesh size, 10)]")
     ap.add_argument("--csv", default=None)
     ap.add_argument("--verbose", action="store_true")
     args, _petsc = ap.parse_known_args(argv)   # the rest goes to PETSc
+    if args.mesh_size is not None and args.contact_size is not None and len(args.levels) > 1:
+        ap.error(f"--mesh-size and --contact-size together replace both sizes of every level: "
+                 f"give one level, not --levels {' '.join(map(str, args.levels))}")
+    for level in args.levels:     # refused before any mesh is built
+        try:
+            level_sizes(level, args.mesh_size, args.contact_size)
+        except ValueError as exc:
+            ap.error(str(exc))
     rows = []
-    head = (f"{'level':>5} {'DOFs':>7} {'points':>6} {'mu':>4} {'k':>7} {'rev':>4} "
+    head = (f"{'level':>5} {'h':>5} {'h_c':>5} {'DOFs':>7} {'verts':>6} {'points':>6} "
+            f"{'mu':>4} {'k':>7} {'rev':>4} "
             f"{'predictor':>9} {'AL':>2} {'upd':>4} {'Nupd':>5} {'cont':>10} {'linear':>6} "
             f"{'Newton':>6} {'solves':>6} {'cutb':>4} {'max/inc':>7} {'CPU s':>7} "
             f"{'D peak':>10} {'D end':>10} {'slip':>5} {'kg/t':>8} {'kTs/t':>8}")
@@ -186,11 +235,13 @@ def main(argv=None):
                     r = run(level, mu, k, w, pred, quad, verbose=args.verbose,
                             reversal_stiffness=rs, augmented=al, al_tol=args.al_tol,
                             continuation=cont, linear_solver=ls,
-                            residual_ratio=args.residual_ratio, basis=basis)
+                            residual_ratio=args.residual_ratio, basis=basis,
+                            mesh_size=args.mesh_size, contact_size=args.contact_size)
                     rows.append(r)
                     label = pred + "/" + quad[0] + ("*" if basis == "dual" else "")
                     PETSc.Sys.Print(
-                        f"{r['level']:5d} {r['dofs']:7d} {r['points']:6d} {mu:4.2f} {k:7.1e} "
+                        f"{r['level']:5d} {r['mesh_size']:5.3g} {r['contact_size']:5.3g} "
+                        f"{r['dofs']:7d} {r['vertices']:6d} {r['points']:6d} {mu:4.2f} {k:7.1e} "
                         f"{rs:4.2g} {label:>9} {al:2d} {r['al_updates']:4d} "
                         f"{r['newton_updates']:5d} "
                         f"{r['continuation']:>10} {r['linear_solver']:>6} "
