@@ -282,7 +282,7 @@ class ContactProblem:
         compat.set_bc_array(self.u.x.array, self.bcs)
         self.u.x.scatter_forward()
         self.b = self.f.duplicate()
-        self.counters = {"residual": 0, "jacobian": 0}
+        self.counters = {"residual": 0, "jacobian": 0, "rebuild": 0}
         self._node_keys = False              # owned_node_keys, not computed yet
         self.callback_error: Optional[BaseException] = None   # see F
         self.timings = {"bulk": 0.0, "interface_residual": 0.0, "interface_jacobian": 0.0}
@@ -506,6 +506,7 @@ class ContactProblem:
             self._K_bulk.assemble()
         self.K = self.interface.create_matrix(self.a)
         self.K.axpy(1.0, self._K_bulk, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
+        self.counters["rebuild"] += 1
         self.A = self.K.duplicate(copy=False)
         if self._seat_form is not None:
             self._assemble_seating()
