@@ -235,7 +235,7 @@ def _shape_hermite(elliptic: str, n: int = _HERMITE_KNOTS, u_min: float = _HERMI
         (u of the knots, 1/(knot spacing) per interval, coefficients (4 functions x 4
         powers, n - 1) of the cubic in the local coordinate of each interval).
     """
-    from .tables import hermite_eval, limited_slopes
+    from .tables import hermite_coeffs, hermite_eval, limited_slopes
 
     y_dense = (_LOG_E1_MIN * np.linspace(0.0, 1.0, 2001) ** 2)[::-1]
     u_dense = _log_lambda_of_log_e1(y_dense)
@@ -256,22 +256,22 @@ def _shape_hermite(elliptic: str, n: int = _HERMITE_KNOTS, u_min: float = _HERMI
         D[:, e] = (-(h1 + h2) / (h1 * h2) * Y[:, i0] + h2 / (h1 * (h2 - h1)) * Y[:, i1]
                    - h1 / (h2 * (h2 - h1)) * Y[:, i2])
     dx = np.diff(u)
-    y0, m0, m1 = Y[:, :-1], D[:, :-1] * dx, D[:, 1:] * dx
-    dy = Y[:, 1:] - y0
-    C = np.stack([y0, m0, 3.0 * dy - 2.0 * m0 - m1, -2.0 * dy + m0 + m1], axis=1)
+    C = np.moveaxis(hermite_coeffs(Y[:, :-1], Y[:, 1:], D[:, :-1], D[:, 1:], dx), 0, 1)
     return u, 1.0 / dx, np.ascontiguousarray(C.reshape(16, -1))
 
 
 def _shape_factors_hermite(x, elliptic: str, n_f: int = 4):
     """ln of the first ``n_f`` of (f1, f2, f3, KE) at u = ln(lambda) in [u_min, 0] by the
     cubic Hermite table: an array (n_f, *x.shape)."""
+    from .tables import horner
+
     u, inv, C = _shape_hermite(elliptic)
     xf = np.clip(np.ravel(x), u[0], 0.0)
     i = ((xf - u[0]) * ((u.size - 1) / -u[0])).astype(np.intp)
     np.clip(i, 0, u.size - 2, out=i)
     t = (xf - u[i]) * inv[i]
     c = C[:4 * n_f, i].reshape(n_f, 4, -1)
-    y = c[:, 0] + t * (c[:, 1] + t * (c[:, 2] + t * c[:, 3]))
+    y = horner(np.moveaxis(c, 1, 0), t)
     return y.reshape((n_f,) + np.shape(x))
 
 
