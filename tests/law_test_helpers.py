@@ -1,11 +1,42 @@
-"""Closed-form stand-ins for the tabulated normal law, shared by the interface-law tests
-(``tests/unit/test_law.py``, ``tests/unit/test_rough_multiplier.py``, which put this folder on
-sys.path). They implement what ``InterfaceLaw`` asks of a normal law (``evaluate(h,
-curvature)``, ``separation_for_pressure``). Units: mm, MPa.
+"""Shared by the interface-law tests (``tests/unit/test_law.py``,
+``tests/unit/test_rough_multiplier.py``, which put this folder on sys.path): closed-form
+stand-ins for the tabulated normal law (what ``InterfaceLaw`` asks of a normal law:
+``evaluate(h, curvature)``, ``separation_for_pressure``), a random committed state, and the
+central-difference check of a law's consistent tangent. Units: mm, MPa.
 """
 from __future__ import annotations
 
 import numpy as np
+
+from rough_contact.interface.state import InterfaceState
+
+
+def random_state(rng, n, scale=1e-4):
+    """A committed state of n points: plastic slip ~ N(0, scale), hardening variables in
+    [0, 5 scale)."""
+    return InterfaceState(rng.normal(size=(n, 2)) * scale, rng.uniform(0, 5 * scale, (n, 2)),
+                          rng.uniform(0, 5 * scale, n))
+
+
+def fd_check(law, jump, st, keep=None, rel_step=1e-7, tol=1e-6):
+    """Assert that the largest |central difference - tangent| over the points ``keep`` (all:
+    None), relative to each point's largest tangent entry, is <= ``tol``; return the law's
+    result at ``jump``."""
+    r = law.evaluate(jump, st)
+    scale = np.abs(r.tangent).max(axis=(1, 2))
+    worst = 0.0
+    for j in range(3):
+        h = rel_step * max(np.abs(jump[:, j]).max(), 1e-4)
+        jp, jm = jump.copy(), jump.copy()
+        jp[:, j] += h
+        jm[:, j] -= h
+        fd = (law.evaluate(jp, st).traction - law.evaluate(jm, st).traction) / (2 * h)
+        err = np.abs(fd - r.tangent[:, :, j]).max(axis=1) / np.where(scale > 0, scale, 1.0)
+        if keep is not None:
+            err = err[keep]
+        worst = max(worst, err.max())
+    assert worst <= tol, worst
+    return r
 
 
 class ExponentialNormal:

@@ -14,16 +14,12 @@ from rough_contact.interface.state import InterfaceState, StatePair
 from rough_contact.interface.tangential import TangentialStiffness
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))   # tests/: shared stand-in laws
-from normal_standins import ExponentialNormal, QuadraticNormal  # noqa: E402
+from law_test_helpers import (ExponentialNormal, QuadraticNormal,  # noqa: E402
+                              fd_check, random_state)
 
 ORTHO = OrthotropicSlipHardening((0.3, 0.5), (0.5, 0.7), (275.0, 100.0), potential_axes=(0.125, 0.2))
 ISO = IsotropicSlipHardening(0.4, 0.5, 275.0)
 TS = TangentialStiffness((0.7, 1.0))
-
-
-def random_state(rng, n, scale=1e-4):
-    return InterfaceState(rng.normal(size=(n, 2)) * scale, rng.uniform(0, 5 * scale, (n, 2)),
-                          rng.uniform(0, 5 * scale, n))
 
 
 def test_contract_and_purity():
@@ -106,25 +102,6 @@ def test_near_zero_pressure_is_finite():
     assert np.all(f <= 1e-12 * r.pressure + 1e-300)
 
 
-def _fd_check(law, jump, st, keep=None, rel_step=1e-7, tol=1e-6):
-    r = law.evaluate(jump, st)
-    D = r.tangent
-    scale = np.abs(D).max(axis=(1, 2))
-    worst = 0.0
-    for j in range(3):
-        h = rel_step * max(np.abs(jump[:, j]).max(), 1e-4)
-        jp, jm = jump.copy(), jump.copy()
-        jp[:, j] += h
-        jm[:, j] -= h
-        fd = (law.evaluate(jp, st).traction - law.evaluate(jm, st).traction) / (2 * h)
-        err = np.abs(fd - D[:, :, j]).max(axis=1) / scale
-        if keep is not None:
-            err = err[keep]
-        worst = max(worst, err.max())
-    assert worst <= tol, worst
-    return r
-
-
 def _away_from_switch(law, jump, st, band=1e-4):
     """Points whose trial slip function is not within `band` (relative) of the switch."""
     p, k, _ = law.normal.evaluate(law.h0 + jump[:, 0])
@@ -151,7 +128,7 @@ def test_consistent_tangent_fd(friction, ts, regime):
     jump = np.column_stack([rng.uniform(-1e-3, 1e-3, n),
                             st.plastic_slip + rng.normal(size=(n, 2)) * scale])
     keep = _away_from_switch(law, jump, st)
-    r = _fd_check(law, jump, st, keep)
+    r = fd_check(law, jump, st, keep)
     frac = r.slipping[keep].mean()
     assert {"stick": frac == 0, "slip": frac > 0.97, "mixed": 0.1 < frac < 0.9}[regime], frac
     # coupling to the normal jump is present (dt_T/dg != 0) where there is traction
@@ -180,7 +157,7 @@ def test_consistent_tangent_fd_with_real_normal_law(real_normal, friction):
     st = random_state(rng, h.size)
     jump = np.column_stack([h - law.h0, st.plastic_slip + rng.normal(size=(h.size, 2)) * 3e-4])
     keep = _away_from_switch(law, jump, st)
-    r = _fd_check(law, jump, st, keep, rel_step=1e-9 / 3e-3)
+    r = fd_check(law, jump, st, keep, rel_step=1e-9 / 3e-3)
     assert 0.1 < r.slipping[keep].mean() < 0.9
 
 

@@ -37,7 +37,8 @@ from rough_contact.interface.state import InterfaceState
 from rough_contact.interface.tangential import TangentialStiffness
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))   # tests/: shared stand-in laws
-from normal_standins import ExponentialNormal, QuadraticNormal  # noqa: E402
+from law_test_helpers import (ExponentialNormal, QuadraticNormal,  # noqa: E402
+                              fd_check, random_state)
 
 
 ORTHO = OrthotropicSlipHardening((0.3, 0.5), (0.5, 0.7), (275.0, 100.0),
@@ -48,11 +49,6 @@ ISO = IsotropicSlipHardening(0.4, 0.5, 275.0)
 TS = TangentialStiffness((0.7, 1.0))
 TS_ISO = TangentialStiffness((0.7, 0.7))
 FRICTIONS = {"ortho": ORTHO, "ortho_k": ORTHO_K, "iso": ISO}
-
-
-def random_state(rng, n, scale=1e-4):
-    return InterfaceState(rng.normal(size=(n, 2)) * scale, rng.uniform(0, 5 * scale, (n, 2)),
-                          rng.uniform(0, 5 * scale, n))
 
 
 def trial_ratio(law, jump, st, lam_t):
@@ -208,23 +204,6 @@ def test_closed_forms_stick_and_slip(name):
     assert np.all(r.dissipation >= 0.0) and np.all(r.dissipation[stick] == 0.0)
 
 
-def _fd_check(law, jump, st, keep, rel_step=1e-7, tol=1e-6):
-    """Largest |FD - D| over the kept points, relative to each point's largest |D|."""
-    r = law.evaluate(jump, st)
-    scale = np.abs(r.tangent).max(axis=(1, 2))
-    worst = 0.0
-    for j in range(3):
-        h = rel_step * max(np.abs(jump[:, j]).max(), 1e-4)
-        jp, jm = jump.copy(), jump.copy()
-        jp[:, j] += h
-        jm[:, j] -= h
-        fd = (law.evaluate(jp, st).traction - law.evaluate(jm, st).traction) / (2 * h)
-        err = np.abs(fd - r.tangent[:, :, j]).max(axis=1) / np.where(scale > 0, scale, 1.0)
-        worst = max(worst, err[keep].max())
-    assert worst <= tol, worst
-    return r
-
-
 CASES = [("ortho", TS), ("ortho_k", TS), ("iso", TS_ISO), ("iso", TS)]
 
 
@@ -253,7 +232,7 @@ def test_tangent_matches_central_differences(name, ts, regime, normal):
     # points close to opening (h near h_max) are kinks of the quadratic law: leave them out
     if normal == "quadratic":
         keep &= law.h0 + jump[:, 0] < nl.h_max - 1e-5
-    r = _fd_check(shifted, jump, st, keep)
+    r = fd_check(shifted, jump, st, keep)
     frac = r.slipping[keep].mean()
     assert {"stick": frac == 0.0, "slip": frac > 0.97, "mixed": 0.1 < frac < 0.9}[regime], frac
     assert np.abs(r.tangent[keep, 1:, 0]).max() > 0       # coupling to the normal jump
@@ -286,7 +265,7 @@ def test_tangent_with_normal_memory():
     p = law.normal.evaluate_history(h, st.h_min)[0]
     keep = (np.abs(h - st.h_min) > 1e-5) & (p > 0)         # off the branch switch
     keep &= np.abs(trial_ratio_history(law, jump, st, lam[:, 1:]) - 1.0) > 1e-4
-    r = _fd_check(shifted, jump, st, keep, rel_step=1e-8)
+    r = fd_check(shifted, jump, st, keep, rel_step=1e-8)
     assert 0.1 < r.slipping[keep].mean() < 0.9
     assert (h[keep] > st.h_min[keep]).sum() > 50 and (h[keep] < st.h_min[keep]).sum() > 50
 
@@ -445,4 +424,4 @@ def test_stiffness_factor_is_the_law_with_a_stiffer_kt(regime):
     keep = np.abs(trial_ratio(ref, jump, st, lam[:, 1:]) - 1.0) > 1e-4
     frac = r.slipping[keep].mean()
     assert {"stick": frac == 0.0, "slip": frac > 0.97, "mixed": 0.1 < frac < 0.9}[regime], frac
-    _fd_check(shifted, jump, st, keep)
+    fd_check(shifted, jump, st, keep)
