@@ -1,13 +1,15 @@
 """Shared by the interface-law tests (``tests/unit/test_law.py``,
 ``tests/unit/test_rough_multiplier.py``, which put this folder on sys.path): closed-form
 stand-ins for the tabulated normal law (what ``InterfaceLaw`` asks of a normal law:
-``evaluate(h, curvature)``, ``separation_for_pressure``), a random committed state, and the
+``evaluate(h, curvature)``, ``separation_for_pressure``), a random committed state, the trial
+friction ratio of a law at a state, and the
 central-difference check of a law's consistent tangent. Units: mm, MPa.
 """
 from __future__ import annotations
 
 import numpy as np
 
+from rough_contact.interface.friction import OrthotropicSlipHardening
 from rough_contact.interface.state import InterfaceState
 
 
@@ -71,3 +73,19 @@ class QuadraticNormal:
 
     def separation_for_pressure(self, p):
         return self.h_max - np.sqrt(np.asarray(p, float) / self.c)
+
+
+def trial_ratio(law, jump, st, lam_t):
+    """||t_trial||_mu / p with t_trial = lambda_T + c kN (s - s_p) (committed coefficients),
+    computed from the normal law directly."""
+    p, k, _ = law.normal.evaluate(law.h0 + jump[:, 0])
+    c = np.array(law.tangential.kt_over_kn)
+    ttr = lam_t + c * k[:, None] * (jump[:, 1:] - st.plastic_slip)
+    if isinstance(law.friction, OrthotropicSlipHardening):
+        mu, _ = law.friction.coefficients(st.accumulated_slip)
+        ntr = np.hypot(ttr[:, 0] / mu[:, 0], ttr[:, 1] / mu[:, 1])
+    else:
+        mu, _ = law.friction.coefficient(st.slip_path)
+        ntr = np.hypot(*ttr.T) / mu
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return ntr / p

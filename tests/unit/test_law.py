@@ -15,7 +15,7 @@ from rough_contact.interface.tangential import TangentialStiffness
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))   # tests/: shared stand-in laws
 from law_test_helpers import (ExponentialNormal, QuadraticNormal,  # noqa: E402
-                              fd_check, random_state)
+                              fd_check, random_state, trial_ratio)
 
 ORTHO = OrthotropicSlipHardening((0.3, 0.5), (0.5, 0.7), (275.0, 100.0), potential_axes=(0.125, 0.2))
 ISO = IsotropicSlipHardening(0.4, 0.5, 275.0)
@@ -104,16 +104,7 @@ def test_near_zero_pressure_is_finite():
 
 def _away_from_switch(law, jump, st, band=1e-4):
     """Points whose trial slip function is not within `band` (relative) of the switch."""
-    p, k, _ = law.normal.evaluate(law.h0 + jump[:, 0])
-    c = np.array(law.tangential.kt_over_kn)
-    ttr = c * k[:, None] * (jump[:, 1:] - st.plastic_slip)
-    if isinstance(law.friction, OrthotropicSlipHardening):
-        mu, _ = law.friction.coefficients(st.accumulated_slip)
-        ntr = np.hypot(ttr[:, 0] / mu[:, 0], ttr[:, 1] / mu[:, 1])
-    else:
-        mu, _ = law.friction.coefficient(st.slip_path)
-        ntr = np.hypot(*ttr.T) / mu
-    return np.abs(ntr / p - 1) > band
+    return np.abs(trial_ratio(law, jump, st, 0.0) - 1) > band
 
 
 @pytest.mark.parametrize("friction", [ORTHO, ISO], ids=["ortho", "iso"])

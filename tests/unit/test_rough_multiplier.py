@@ -38,7 +38,7 @@ from rough_contact.interface.tangential import TangentialStiffness
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))   # tests/: shared stand-in laws
 from law_test_helpers import (ExponentialNormal, QuadraticNormal,  # noqa: E402
-                              fd_check, random_state)
+                              fd_check, random_state, trial_ratio)
 
 
 ORTHO = OrthotropicSlipHardening((0.3, 0.5), (0.5, 0.7), (275.0, 100.0),
@@ -49,22 +49,6 @@ ISO = IsotropicSlipHardening(0.4, 0.5, 275.0)
 TS = TangentialStiffness((0.7, 1.0))
 TS_ISO = TangentialStiffness((0.7, 0.7))
 FRICTIONS = {"ortho": ORTHO, "ortho_k": ORTHO_K, "iso": ISO}
-
-
-def trial_ratio(law, jump, st, lam_t):
-    """||t_trial||_mu / p with t_trial = lambda_T + c kN (s - s_p) (committed coefficients),
-    computed from the normal law directly."""
-    p, k, _ = law.normal.evaluate(law.h0 + jump[:, 0])
-    c = np.array(law.tangential.kt_over_kn)
-    ttr = lam_t + c * k[:, None] * (jump[:, 1:] - st.plastic_slip)
-    if isinstance(law.friction, OrthotropicSlipHardening):
-        mu, _ = law.friction.coefficients(st.accumulated_slip)
-        ntr = np.hypot(ttr[:, 0] / mu[:, 0], ttr[:, 1] / mu[:, 1])
-    else:
-        mu, _ = law.friction.coefficient(st.slip_path)
-        ntr = np.hypot(*ttr.T) / mu
-    with np.errstate(divide="ignore", invalid="ignore"):
-        return ntr / p
 
 
 def multipliers_for(law, jump, rng, size):
