@@ -48,7 +48,10 @@ from rough_contact.fem.contact import ContactInterface
 from rough_contact.fem.jump import JumpOperator
 from rough_contact.fem.pairing.base import PairedPoints, SurfaceContext, local_frames
 from rough_contact.fem.pairing.facets import basix_cell
-from rough_contact.interface.enforcement import NewtonAugmentedLagrangian
+from rough_contact.fem.condensation import DualCondensation
+from rough_contact.interface.contract import LawResult
+from rough_contact.interface.enforcement import NewtonAugmentedLagrangian, SemismoothNewton
+from rough_contact.interface.state import InterfaceState
 
 __all__ = ["NodalContactInterface", "NodalPoints", "VertexJumpOperator", "nodal_points",
            "vertex_shape_matrix"]
@@ -320,8 +323,19 @@ class NodalContactInterface(ContactInterface):
         if sliding != "small":
             raise ValueError(f"sliding = {sliding!r} is invalid for the nodal point set: only "
                              "'small' (the vertex rows are built once at set-up)")
+        enforcement = kwargs.get("enforcement")
+        if isinstance(enforcement, SemismoothNewton):
+            degree = V.element.basix_element.degree
+            if basis != "dual" or degree != 1:
+                raise ValueError(
+                    f"the semismooth Newton enforcement condenses the tractions through the "
+                    f"dual basis on first-order displacements: basis = {basis!r} (must be "
+                    f"'dual') with displacement degree {degree} (must be 1: P1 or Q1); for "
+                    "P2/Q2 use NewtonAugmentedLagrangian")
         super().__init__(V, facet_tags, first_tag, second_tag, **kwargs)
         self.newton_updates = 0      # multiplier updates inside Newton iterations (all solves)
+        self._condensation = None    # built at the first condensed_matrix (Dirichlet rows final)
+        self._condensed_iterate = None
 
     def _point_set(self, ctx: SurfaceContext, bcs: Sequence) -> JumpOperator:
         quad = JumpOperator(ctx.V, self.paired, bcs=bcs)
@@ -368,6 +382,65 @@ class NodalContactInterface(ContactInterface):
         self._last = None      # the solver evaluates again; the Newton-step memo is kept
         self.newton_updates += 1
         return True
+
+    # ------------------------------------------------------------ semismooth Newton
+    def condenses(self) -> bool:
+        """Whether the tractions are condensed (``SemismoothNewton``;
+        ``rough_contact.fem.condensation.CondensedInterface``)."""
+        return isinstance(self.enforcement, SemismoothNewton)
+
+    def condensed_matrix(self, K: PETSc.Mat) -> PETSc.Mat:
+        """A Jacobian matrix with the condensed pattern (collective; builds the condensation
+        with the Dirichlet rows known now)."""
+        mu, rn, rt = self.enforcement.parameters(self.law)
+        self._condensation = DualCondensation(self.V, self.nodal, self.operator._rows, mu, rn,
+                                              rt)
+        return self._condensation.matrix(K)
+
+    def condense_residual(self, u, b: PETSc.Vec) -> None:
+        """b = F_b(u) (assembled, Dirichlet rows set) -> H(u) (collective; module
+        ``rough_contact.fem.condensation``). The tractions, contact, slip, plastic slip and
+        dissipation at u become the interface's last evaluation (its trial state)."""
+        cond = self._condensation
+        jump = self.jump(u)
+        committed = self.history.law.committed
+        t, ac = cond.residual(b, jump, committed.plastic_slip)
+        cond.add_partner_rows(b)
+        b.assemblyBegin()
+        b.assemblyEnd()
+        dslip = np.abs(ac.plastic_slip - committed.plastic_slip)
+        state = InterfaceState(ac.plastic_slip, committed.accumulated_slip + dslip,
+                               committed.slip_path + np.linalg.norm(
+                                   ac.plastic_slip - committed.plastic_slip, axis=1))
+        contact = ac.contact & (t[:, 0] < 0.0)
+        res = LawResult(traction=t, tangent=np.zeros((t.shape[0], 3, 3)), state=state,
+                        dissipation=ac.dissipation, area_fraction=contact.astype(float),
+                        contact=contact, slipping=ac.slipping & contact)
+        self.history.law.update(res)
+        self._last, self._last_jump = res, jump
+        self._condensed_iterate = ac
+
+    def condense_jacobian(self, K: PETSc.Mat, A: PETSc.Mat) -> None:
+        """A = the condensed Jacobian at the iterate of the last :meth:`condense_residual`
+        (collective)."""
+        if self._condensed_iterate is None:
+            raise RuntimeError("condense_jacobian before condense_residual: the semismooth "
+                               "Newton's Jacobian is taken at the last residual's iterate")
+        self._condensation.jacobian(self._condensed_iterate, A)
+
+    def evaluate(self, u) -> LawResult:
+        """``ContactInterface.evaluate``; with the semismooth Newton the last residual's
+        result, which must be at u (the tractions come from the residual, not from the law)."""
+        if not self.condenses():
+            return super().evaluate(u)
+        if self._last is None or not np.array_equal(self.jump(u), self._last_jump):
+            raise RuntimeError("the semismooth Newton's tractions are those of the last "
+                               "residual evaluation, which was not at this displacement")
+        return self._last
+
+    def _forget(self) -> None:
+        super()._forget()
+        self._condensed_iterate = None
 
     def describe(self) -> dict:
         """``ContactInterface.describe`` plus the point set (a checkpoint of the quadrature

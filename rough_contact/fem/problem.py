@@ -38,6 +38,7 @@ from petsc4py import PETSc
 
 from rough_contact.fem import compat
 from rough_contact.fem.contact import ContactInterface
+from rough_contact.fem.condensation import CondensedInterface
 from rough_contact.fingerprint import describe
 from rough_contact.validation import check_scalar
 
@@ -376,7 +377,12 @@ class ContactProblem:
         self.K.zeroEntries()
         fem_petsc.assemble_matrix(self.K, self.a, bcs=self.bcs)
         self.K.assemble()
-        self.A = self.K.duplicate(copy=False)
+        self._condensed = isinstance(interface, CondensedInterface) and interface.condenses()
+        if self._condensed:      # the tractions condensed: rows of K combined per iteration
+            self.A = interface.condensed_matrix(self.K)
+            self.A.setBlockSize(3)
+        else:
+            self.A = self.K.duplicate(copy=False)
         self.setup_time = MPI.Wtime() - t0  # [s] pattern + bulk stiffness assembly
 
         self.f = fem_petsc.assemble_vector(self.L)
@@ -472,11 +478,17 @@ class ContactProblem:
             b.axpy(-self.scales[name], free)
         b.axpy(1.0, self.lift)
         t1 = MPI.Wtime()
-        if self.interface is not None:
+        if self.interface is not None and not self._condensed:
             self.interface.evaluate(self.u)
             self.interface.assemble_residual(b)
+        if self._condensed:
+            b.assemblyBegin()
+            b.assemblyEnd()
+            compat.set_bc(b, self.bcs, x, -1.0)
+            self.interface.condense_residual(self.u, b)
+        else:
+            compat.set_bc(b, self.bcs, x, -1.0)
         t2 = MPI.Wtime()
-        compat.set_bc(b, self.bcs, x, -1.0)
         self.timings["bulk"] += t1 - t0
         self.timings["interface_residual"] += t2 - t1
         self.counters["residual"] += 1
@@ -530,15 +542,20 @@ class ContactProblem:
     def _jacobian(self, x: PETSc.Vec, A: PETSc.Mat, P: PETSc.Mat) -> None:
         self.update_solution(x)
         t0 = MPI.Wtime()
-        self.K.copy(A, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
-        t1 = MPI.Wtime()
-        if self.interface is not None:   # at the iterate of the last residual (SNES order)
-            self.interface.assemble_jacobian(A)
+        if self._condensed:              # at the iterate of the last residual (SNES order)
+            t1 = MPI.Wtime()
+            self.interface.condense_jacobian(self.K, A)
+        else:
+            self.K.copy(A, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+            t1 = MPI.Wtime()
+            if self.interface is not None:   # at the iterate of the last residual (SNES order)
+                self.interface.assemble_jacobian(A)
         A.assemble()
         t2 = MPI.Wtime()
         self.seating_active = False
         if self.M_seat is not None and self.n_in_contact() == 0:
-            A.axpy(1.0, self.M_seat, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+            A.axpy(1.0, self.M_seat, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN
+                   if not self._condensed else PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
             self.seating_active = True
         self.timings["bulk"] += t1 - t0
         self.timings["interface_jacobian"] += t2 - t1

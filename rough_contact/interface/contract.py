@@ -71,6 +71,7 @@ from typing import Optional, Protocol, TypeVar, runtime_checkable
 import numpy as np
 
 __all__ = ["ConvergenceError", "LawState", "LawResult", "InterfaceLawProtocol",
+           "CoulombLimit", "CoulombContactLaw",
            "FrictionBoundedLaw", "NewtonTangentLaw", "MultiplierLaw", "SoftenableLaw",
            "LawContractError", "check_jump"]
 
@@ -252,6 +253,34 @@ class MultiplierLaw(Protocol):
         bodies): an object with the
         same ``initial_state``/``evaluate`` (and ``newton_tangent``, if the law has one) for
         those n points; cheap to create (no copy of the arrays)."""
+        ...
+
+
+@dataclass(frozen=True)
+class CoulombLimit:
+    """The exact limit of a Coulomb penalty law: unilateral contact (Signorini) with isotropic
+    Coulomb friction, and the law's penalties (a natural scale for an augmentation).
+
+    Attributes:
+        friction: Coulomb's mu >= 0 (0: frictionless) [-].
+        k_normal, k_tangential: the law's penalties [MPa/mm] (k_tangential 0: frictionless).
+    """
+
+    friction: float
+    k_normal: float
+    k_tangential: float
+
+
+@runtime_checkable
+class CoulombContactLaw(Protocol):
+    """A penalty law whose penalty-to-infinity limit is unilateral contact with isotropic
+    Coulomb friction and whose state is ``InterfaceState`` (``SoftplusPenalty``): the
+    semismooth Newton enforcement (``rough_contact.interface.enforcement.SemismoothNewton``)
+    solves that limit exactly instead of the penalty. The rough law is no such law: its
+    normal compliance is physical."""
+
+    def coulomb_limit(self) -> CoulombLimit:
+        """The law's exact limit and penalties."""
         ...
 
 

@@ -12,7 +12,11 @@ law such as ``SoftplusPenalty`` — can be used
 * with exact constraints and the multipliers updated inside the Newton iteration
   (:class:`NewtonAugmentedLagrangian`): lambda <- the tractions at every Newton iterate, the
   same fixed point as Uzawa's at the cost of about one Newton solve per increment (nodal
-  points, ``rough_contact.fem.nodal``).
+  points, ``rough_contact.fem.nodal``);
+* with exact constraints by Alart–Curnier's semismooth Newton (:class:`SemismoothNewton`):
+  the contact and Coulomb conditions are equations solved with the equilibrium, the tractions
+  condensed through the dual basis (``rough_contact.fem.condensation``); the law must be a
+  :class:`~rough_contact.interface.contract.CoulombContactLaw`, whose penalty is not used.
 
 A strategy is pure numpy and holds no per-point data: the multipliers live in the interface's
 history (:class:`~rough_contact.interface.state.InterfaceHistory`), the global reductions and
@@ -30,10 +34,10 @@ from typing import Optional, Protocol, Union, runtime_checkable
 import numpy as np
 
 from ..validation import check_scalar
-from .contract import InterfaceLawProtocol, LawResult, MultiplierLaw
+from .contract import CoulombContactLaw, CoulombLimit, InterfaceLawProtocol, LawResult, MultiplierLaw
 
 __all__ = ["Enforcement", "Penalty", "AugmentedLagrangian", "NewtonAugmentedLagrangian",
-           "MultiplierUpdate"]
+           "SemismoothNewton", "MultiplierUpdate"]
 
 
 @dataclass(frozen=True)
@@ -214,3 +218,65 @@ class NewtonAugmentedLagrangian(AugmentedLagrangian):
                 or isinstance(self.first_iteration, bool) or self.first_iteration < 0):
             raise ValueError(f"first_iteration = {self.first_iteration!r} is invalid: it must "
                              "be an integer >= 0 (Newton iteration)")
+
+
+@dataclass(frozen=True)
+class SemismoothNewton:
+    """Exact contact and Coulomb stick by Alart–Curnier's semismooth Newton.
+
+    The complementarity function of ``rough_contact.interface.alart_curnier`` is solved
+    together with the equilibrium in one Newton iteration; the tractions are condensed
+    vertex by vertex through the dual basis (``rough_contact.fem.condensation``), so the
+    Newton system has the displacement's size and no multiplier loop exists: a converged
+    Newton solve is exact. As in GetFEM's Alart–Curnier contact, the active contact and stick
+    sets are updated at every iterate (a semismooth Newton; the backtracking line search on the
+    residual norm globalises it).
+
+    The law is used only for its exact limit (``CoulombContactLaw.coulomb_limit``: mu); its
+    penalty and smoothing are not: the answer is Signorini–Coulomb's. Nodal point set with the
+    dual basis on P1/Q1 displacements (``NodalContactInterface(basis="dual")``), small sliding.
+
+    Args:
+        r_normal, r_tangential: the augmentation parameters r_N, r_T > 0 [MPa/mm] (None: the
+            law's penalties; r_T None: r_N if r_N is given or the law is frictionless, else
+            the law's k_T). They do not change
+            the answer, only which branch an iterate is on (about E / h suits; docs).
+    """
+
+    r_normal: Optional[float] = None
+    r_tangential: Optional[float] = None
+    name: str = "semismooth_newton"
+
+    def __post_init__(self) -> None:
+        for what, r in (("r_normal", self.r_normal), ("r_tangential", self.r_tangential)):
+            if r is not None:
+                check_scalar(what, r, lo=0.0, unit="MPa/mm")
+
+    def check_law(self, law: InterfaceLawProtocol) -> None:
+        """The law must be a CoulombContactLaw (its exact limit is what is solved)."""
+        if not isinstance(law, CoulombContactLaw):
+            raise TypeError(
+                f"the semismooth Newton enforcement solves unilateral contact with Coulomb "
+                f"friction exactly and needs a law with that limit (rough_contact.interface."
+                f"contract.CoulombContactLaw: coulomb_limit, e.g. SoftplusPenalty); "
+                f"{type(law).__name__} is not one (for the rough law use AugmentedLagrangian)")
+
+    def initial_multipliers(self, n_points: int) -> None:
+        """No multipliers: the tractions are condensed."""
+        return None
+
+    def law_for(self, law: InterfaceLawProtocol, multipliers: None) -> InterfaceLawProtocol:
+        """The law itself (not evaluated for the residual)."""
+        return law
+
+    def parameters(self, law: CoulombContactLaw) -> tuple[float, float, float]:
+        """(mu, r_N, r_T) for ``law``."""
+        limit: CoulombLimit = law.coulomb_limit()
+        rn = limit.k_normal if self.r_normal is None else self.r_normal
+        if self.r_tangential is not None:
+            rt = self.r_tangential
+        elif self.r_normal is not None or limit.k_tangential <= 0.0:
+            rt = rn
+        else:
+            rt = limit.k_tangential
+        return limit.friction, float(rn), float(rt)

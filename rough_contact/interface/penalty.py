@@ -18,7 +18,7 @@ import numpy as np
 from scipy.special import expit
 
 from ..validation import check_scalar
-from .contract import LawResult, check_jump
+from .contract import CoulombLimit, LawResult, check_jump
 from .state import InterfaceState
 
 __all__ = ["LinearPenalty", "SoftplusPenalty", "ShiftedSoftplusPenalty"]
@@ -182,6 +182,12 @@ class SoftplusPenalty:
                         lam_t) -> np.ndarray:
         """Elastic predictor tau = lambda_T + k_T (s - s_p) (n, 2) [MPa]."""
         return lam_t + self.k_tangential * (jump[:, 1:] - committed.plastic_slip)
+
+    def coulomb_limit(self) -> CoulombLimit:
+        """Signorini contact with Coulomb's mu (0 without tangential stiffness) and this law's
+        penalties (``rough_contact.interface.contract.CoulombContactLaw``)."""
+        mu = float(self.friction) if self.k_tangential > 0.0 else 0.0
+        return CoulombLimit(mu, float(self.k_normal), float(self.k_tangential))
 
     def max_friction_coefficient(self) -> float:
         """mu (0 without tangential stiffness): |t_T| <= mu p
