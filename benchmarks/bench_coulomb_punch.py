@@ -44,6 +44,7 @@ from petsc4py import PETSc  # noqa: E402
 from rough_contact.fem.mesh import facet_vertex_coordinates
 from rough_contact.fem.nodal import NodalContactInterface
 from rough_contact.interface.enforcement import (AugmentedLagrangian, NewtonAugmentedLagrangian,
+                                                 SemismoothNewton,
                                                  Penalty)
 from rough_contact.interface.penalty import SoftplusPenalty
 from rough_contact.scenes import flat_punch
@@ -85,11 +86,13 @@ def contact_vertices(scene, comm) -> int:
 def run(level: int, mu: float, k: float, width: float, predictor: str, quadrature="gauss",
         comm=MPI.COMM_WORLD, verbose=False, reversal_stiffness=1.0, augmented=False,
         al_tol=1e-3, continuation=None, linear_solver="auto", residual_ratio=1e-2,
-        basis="standard", mesh_size=None, contact_size=None) -> dict:
+        basis="standard", mesh_size=None, contact_size=None, ssn_r=None) -> dict:
     mesh_size, contact_size = level_sizes(level, mesh_size, contact_size)
     law = SoftplusPenalty(k_normal=k, width=width, k_tangential=k, friction=mu,
                           reversal_stiffness=reversal_stiffness)
-    if augmented == 2:     # multipliers updated inside the Newton iteration (nodal points)
+    if augmented == 3:     # Alart-Curnier's semismooth Newton, tractions condensed (dual P1)
+        enforcement = SemismoothNewton(r_normal=ssn_r)
+    elif augmented == 2:   # multipliers updated inside the Newton iteration (nodal points)
         enforcement = NewtonAugmentedLagrangian(tolerance=al_tol, residual_ratio=residual_ratio)
     elif augmented:
         enforcement = AugmentedLagrangian(tolerance=al_tol)
@@ -173,8 +176,10 @@ def main(argv=None):
                     "nodal point set through the Gauss rule (rough_contact.fem.nodal)")
     ap.add_argument("--reversal-stiffness", type=float, nargs="+", default=[1.0],
                     help="SoftplusPenalty.reversal_stiffness (0 = consistent tangent everywhere)")
-    ap.add_argument("--augmented", type=int, nargs="+", default=[0], choices=[0, 1, 2],
-                    help="1 = augmented Lagrangian (Uzawa) on top of the penalty; 2 = the "
+    ap.add_argument("--augmented", type=int, nargs="+", default=[0], choices=[0, 1, 2, 3],
+                    help="1 = augmented Lagrangian (Uzawa) on top of the penalty; 3 = Alart-Curnier's "
+                    "semismooth Newton with the tractions condensed (SemismoothNewton: --quadrature "
+                    "nodal --basis dual, P1; augmentation = --k); 2 = the "
                     "multipliers updated inside the Newton iteration (NewtonAugmentedLagrangian, "
                     "--quadrature nodal only)")
     ap.add_argument("--al-tol", type=float, default=1e-3,
@@ -182,6 +187,9 @@ def main(argv=None):
     ap.add_argument("--basis", nargs="+", default=["standard"], choices=["standard", "dual"],
                     help="the nodal set's vertex weights (NodalContactInterface basis): the "
                     "vertex functions or their dual (biorthogonal) basis")
+    ap.add_argument("--ssn-r", type=float, default=None,
+                    help="SemismoothNewton.r_normal (--augmented 3) [MPa/mm]; default: per vertex, "
+                    "the bulk stiffness per area")
     ap.add_argument("--residual-ratio", type=float, default=1e-2,
                     help="NewtonAugmentedLagrangian.residual_ratio (--augmented 2)")
     ap.add_argument("--continuation", nargs="+", default=["100,10"],
@@ -230,13 +238,14 @@ def main(argv=None):
                     cont = (None if co == "none" else Continuation(
                         tuple(float(x) for x in co.split(",")),
                         None if args.after == "none" else int(args.after)))
-                    if al == 2 and quad != "nodal":
+                    if al >= 2 and quad != "nodal":
                         continue       # the in-Newton update is the nodal point set's
                     r = run(level, mu, k, w, pred, quad, verbose=args.verbose,
                             reversal_stiffness=rs, augmented=al, al_tol=args.al_tol,
                             continuation=cont, linear_solver=ls,
                             residual_ratio=args.residual_ratio, basis=basis,
-                            mesh_size=args.mesh_size, contact_size=args.contact_size)
+                            mesh_size=args.mesh_size, contact_size=args.contact_size,
+                            ssn_r=args.ssn_r)
                     rows.append(r)
                     label = pred + "/" + quad[0] + ("*" if basis == "dual" else "")
                     PETSc.Sys.Print(

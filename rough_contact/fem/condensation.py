@@ -44,7 +44,7 @@ Units: mm, N, MPa.
 
 from __future__ import annotations
 
-from typing import Protocol, runtime_checkable
+from typing import Optional, Protocol, runtime_checkable
 
 import numpy as np
 from mpi4py import MPI
@@ -85,8 +85,9 @@ class DualCondensation:
         V: the displacement space (P1/Q1); nodal: the vertex points
             (``rough_contact.fem.nodal.NodalPoints``, dual basis); rows: (n_v, nd) global
             rows of each vertex's DOFs, -1 for Dirichlet and padding columns (the vertex jump
-            operator's); friction, r_normal, r_tangential: Coulomb's mu and the augmentation
-            parameters [MPa/mm].
+            operator's); friction: Coulomb's mu; r_normal, r_tangential: the augmentation
+            parameters [MPa/mm] (None: per vertex, the mean diagonal of the bulk matrix K over
+            the node's free components divided by m_j; r_tangential None: r_normal's).
 
     Raises:
         ValueError (every rank): the first surface's coupling of a vertex is not the identity
@@ -94,10 +95,10 @@ class DualCondensation:
             vertex is not along an axis of its frame.
     """
 
-    def __init__(self, V, nodal, rows: np.ndarray, friction: float, r_normal: float,
-                 r_tangential: float):
+    def __init__(self, V, nodal, rows: np.ndarray, friction: float,
+                 r_normal: Optional[float], r_tangential: Optional[float], K: PETSc.Mat):
         self.comm = comm = V.mesh.comm
-        self.friction, self.r_normal, self.r_tangential = friction, r_normal, r_tangential
+        self.friction = friction
         imap = V.dofmap.index_map
         self.n_local = nl = 3 * imap.size_local
         self.start = s0 = 3 * imap.local_range[0]
@@ -131,7 +132,8 @@ class DualCondensation:
             raise ValueError(
                 f"{n_bad} contact vertices cannot be condensed: the semismooth Newton needs "
                 "the first surface's weighted jump to be the identity on the vertex's own DOFs "
-                "(P1/Q1 displacements with basis='dual') and every Dirichlet component of a "
+                "(P1 displacements, or Q1 on parallelogram facets, with basis='dual': the dual "
+                "basis is biorthogonal there) and every Dirichlet component of a "
                 "contact vertex along an axis of its frame (a symmetry plane at right angles)")
         self.fixed = fixed
         self.sign = sign
@@ -153,6 +155,13 @@ class DualCondensation:
         self._gg = S_rows + s0 + nl                          # G-part rows of Kg for S (own)
         self.n_glob = n_glob
         self._L = self._Kg = None
+        # augmentation: given, or the bulk stiffness per area at the vertex's node
+        d = K.getDiagonal().array[self.S_local] if n_v else np.zeros((0, 3))
+        free = np.maximum((~fixed).sum(axis=1), 1)
+        stiffness = np.where(fixed, 0.0, d).sum(axis=1) / free / self.m
+        self.r_normal = stiffness if r_normal is None else np.full(n_v, float(r_normal))
+        self.r_tangential = self.r_normal if r_tangential is None else \
+            np.full(n_v, float(r_tangential))
 
     # ------------------------------------------------------------------ the residual
     def tractions(self, F_S: np.ndarray) -> np.ndarray:

@@ -394,7 +394,7 @@ class NodalContactInterface(ContactInterface):
         with the Dirichlet rows known now)."""
         mu, rn, rt = self.enforcement.parameters(self.law)
         self._condensation = DualCondensation(self.V, self.nodal, self.operator._rows, mu, rn,
-                                              rt)
+                                              rt, K)
         return self._condensation.matrix(K)
 
     def condense_residual(self, u, b: PETSc.Vec) -> None:

@@ -76,7 +76,8 @@ def alart_curnier(traction: np.ndarray, jump: np.ndarray, plastic_slip: np.ndarr
         traction: (n, 3) t [MPa]; jump: (n, 3) [g, s_x, s_y] [mm];
         plastic_slip: (n, 2) committed s_p [mm];
         friction: Coulomb's mu >= 0 (0: frictionless, Phi_T = t_T);
-        r_normal, r_tangential: augmentation parameters > 0 [MPa/mm].
+        r_normal, r_tangential: augmentation parameters > 0 [MPa/mm], one for all points or
+            (n,) per point.
 
     Raises:
         ValueError: shapes that do not agree, non-finite input, or parameters out of range.
@@ -94,8 +95,8 @@ def alart_curnier(traction: np.ndarray, jump: np.ndarray, plastic_slip: np.ndarr
             raise ValueError(f"{name} is not finite at {bad.size} of {n} points (first: "
                              f"{a[bad[0]].tolist()})")
     mu = check_scalar("friction", friction, lo=0.0, lo_open=False)
-    rn = check_scalar("r_normal", r_normal, lo=0.0, unit="MPa/mm")
-    rt = check_scalar("r_tangential", r_tangential, lo=0.0, unit="MPa/mm")
+    rn = _augmentation("r_normal", r_normal, n)
+    rt = _augmentation("r_tangential", r_tangential, n)
 
     res = np.empty((n, 3))
     dt = np.zeros((n, 3, 3))
@@ -104,35 +105,50 @@ def alart_curnier(traction: np.ndarray, jump: np.ndarray, plastic_slip: np.ndarr
     contact = sig_n <= 0.0      # a tie (touching, no traction) starts closed, not free
     res[:, 0] = t[:, 0] - np.minimum(sig_n, 0.0)
     dt[~contact, 0, 0] = 1.0
-    dj[contact, 0, 0] = -rn
+    dj[contact, 0, 0] = -rn[contact]
 
-    sig_t = t[:, 1:] + rt * (j[:, 1:] - sp)
+    sig_t = t[:, 1:] + rt[:, None] * (j[:, 1:] - sp)
     rho = mu * np.maximum(-sig_n, 0.0)
     norm = np.linalg.norm(sig_t, axis=1)
-    stick = contact & (norm <= rho)
+    stick = contact & (norm <= rho) & (mu > 0.0)   # frictionless: never stuck
     slip = ~stick             # slipping, or out of contact (rho = 0: P = 0)
     proj = sig_t.copy()
     scale = np.divide(rho, norm, out=np.zeros(n), where=norm > 0.0)
     proj[slip] = scale[slip, None] * sig_t[slip]
     res[:, 1:] = t[:, 1:] - proj
     # stick: dPhi_T/ds = -r_T I
-    dj[stick, 1, 1] = dj[stick, 2, 2] = -rt
+    dj[stick, 1, 1] = dj[stick, 2, 2] = -rt[stick]
     # slip (and open: rho = 0, Q = 0): dPhi_T/dt_T = I - Q, dPhi_T/ds = -r_T Q
     m = np.divide(sig_t, norm[:, None], out=np.zeros_like(sig_t), where=norm[:, None] > 0.0)
     Q = scale[:, None, None] * (np.eye(2)[None] - m[:, :, None] * m[:, None, :])
     Q[stick] = 0.0
     dt[:, 1:, 1:] = np.where(stick[:, None, None], 0.0, np.eye(2)[None] - Q)
-    dj[slip, 1:, 1:] = -rt * Q[slip]
+    dj[slip, 1:, 1:] = -rt[slip, None, None] * Q[slip]
     # the bound rho = -mu sigma_N in contact: dP/drho = m
-    slipping = slip & contact
+    slipping = slip & contact & (mu > 0.0)
     dt[slipping, 1:, 0] = mu * m[slipping]
-    dj[slipping, 1:, 0] = mu * rn * m[slipping]
+    dj[slipping, 1:, 0] = mu * rn[slipping, None] * m[slipping]
 
     new_sp = sp.copy()
-    dslip = (sig_t[slip] - proj[slip]) / rt
+    dslip = (sig_t[slip] - proj[slip]) / rt[slip, None]
     new_sp[slip] += dslip
     dissipation = np.zeros(n)
     dissipation[slip] = np.einsum("ij,ij->i", proj[slip], dslip)
     return ComplementarityResult(residual=res, d_traction=dt, d_jump=dj, contact=contact,
                                  slipping=slipping, plastic_slip=new_sp,
                                  dissipation=dissipation)
+
+
+def _augmentation(name: str, r, n: int) -> np.ndarray:
+    """(n,) positive finite augmentation parameters from a scalar or an (n,) array."""
+    a = np.asarray(r, dtype=float)
+    if a.ndim == 0:
+        check_scalar(name, float(a), lo=0.0, unit="MPa/mm")
+        return np.full(n, float(a))
+    if a.shape != (n,):
+        raise ValueError(f"{name} of shape {a.shape} is invalid: a scalar or ({n},)")
+    bad = ~(np.isfinite(a) & (a > 0.0))
+    if np.any(bad):
+        raise ValueError(f"{name} = {a[bad][0]!r} at {int(bad.sum())} of {n} points is invalid: "
+                         "it must be finite and > 0 [MPa/mm]")
+    return a

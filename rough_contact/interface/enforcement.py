@@ -237,10 +237,12 @@ class SemismoothNewton:
     dual basis on P1/Q1 displacements (``NodalContactInterface(basis="dual")``), small sliding.
 
     Args:
-        r_normal, r_tangential: the augmentation parameters r_N, r_T > 0 [MPa/mm] (None: the
-            law's penalties; r_T None: r_N if r_N is given or the law is frictionless, else
-            the law's k_T). They do not change
-            the answer, only which branch an iterate is on (about E / h suits; docs).
+        r_normal, r_tangential: the augmentation parameters r_N, r_T > 0 [MPa/mm]. They do not
+            change the answer, only which branch (contact/open, stick/slip) an iterate is on
+            and so the iteration count. None (the default): per vertex, the bulk stiffness the
+            vertex's node sees per area, the mean diagonal of K over its free components
+            divided by its weight m_j (about E / h; docs/exact_contact_newton.md measures the
+            choice); r_T None: r_N.
     """
 
     r_normal: Optional[float] = None
@@ -269,14 +271,8 @@ class SemismoothNewton:
         """The law itself (not evaluated for the residual)."""
         return law
 
-    def parameters(self, law: CoulombContactLaw) -> tuple[float, float, float]:
-        """(mu, r_N, r_T) for ``law``."""
+    def parameters(self, law: CoulombContactLaw) -> tuple[float, Optional[float], Optional[float]]:
+        """(mu, r_N, r_T) for ``law``; None where the interface takes the bulk stiffness."""
         limit: CoulombLimit = law.coulomb_limit()
-        rn = limit.k_normal if self.r_normal is None else self.r_normal
-        if self.r_tangential is not None:
-            rt = self.r_tangential
-        elif self.r_normal is not None or limit.k_tangential <= 0.0:
-            rt = rn
-        else:
-            rt = limit.k_tangential
-        return limit.friction, float(rn), float(rt)
+        rt = self.r_tangential if self.r_tangential is not None else self.r_normal
+        return limit.friction, self.r_normal, rt

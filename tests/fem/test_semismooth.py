@@ -1,0 +1,186 @@
+"""Alart–Curnier's semismooth Newton with the tractions condensed through the dual basis
+(``SemismoothNewton``; rough_contact.fem.condensation; docs/exact_contact_newton.md).
+
+* Patch test: two blocks pressed by a uniform pressure, Coulomb mu = 0.3, conforming P1,
+  mortar P1 and conforming Q1: every vertex carries the pressure to round-off, the gap is closed,
+  no shear; a linear problem once the contact set is right: at most 2 Newton iterations per
+  increment; serial = 2 ranks.
+* The condensed Jacobian equals central differences of the condensed residual at a state
+  with open, sticking and slipping vertices (mortar P1, non-matching meshes).
+* GetFEM's flat punch on a coarse mesh (P1, mu = 0.2, loading and unloading): the same
+  dissipation history and vertex tractions as the multipliers updated inside Newton
+  (``NewtonAugmentedLagrangian``, a different iteration whose fixed point is the same up to
+  its softplus smoothing), in fewer Newton iterations; serial = 2 ranks.
+* Refusals: the standard basis, P2 displacements.
+
+Run serial and in parallel:
+    .venv/bin/python -m pytest tests/fem/test_semismooth.py
+    mpirun -n 2 .venv/bin/python -m mpi4py -m pytest tests/fem/test_semismooth.py
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from dolfinx import fem
+from rough_contact.fem import compat
+from rough_contact.fem.nodal import NodalContactInterface
+from rough_contact.fem.problem import ContactProblem, Material, SurfaceLoad
+from rough_contact.interface.enforcement import NewtonAugmentedLagrangian, SemismoothNewton
+from rough_contact.interface.penalty import SoftplusPenalty
+from rough_contact.scenes.meshes.blocks import separate_blocks, two_blocks
+from rough_contact.solver.loading import load_path, load_unload_factors
+from rough_contact.solver.snes import SNESSolver
+
+E, NU, PRESSURE, MU = 2.0e5, 0.25, 80.0, 0.3
+LAW = SoftplusPenalty(1e6, 1e-7, k_tangential=1e6, friction=MU)
+
+
+def _roller(V, scene, name, comp):
+    facets = scene.facet_tags.find(scene.tag(name))
+    dofs = fem.locate_dofs_topological(V.sub(comp), 2, facets)
+    return fem.dirichletbc(PETSc.ScalarType(0.0), dofs, V.sub(comp))
+
+
+def _blocks(comm, pairing, cell_type="tetrahedron", order=1, basis="dual", shear=0.0):
+    if pairing == "conforming":
+        scene = two_blocks(h1=1.0, h2=0.5, mesh_size=0.3, order=order, comm=comm,
+                           cell_type=cell_type)
+    else:
+        scene = separate_blocks(h1=1.0, h2=0.5, size_lower=0.2, size_upper=0.28, order=order,
+                                comm=comm, cell_type=cell_type)
+    V = compat.vector_space(scene.mesh, order)
+    bcs = [_roller(V, scene, "x0", 0), _roller(V, scene, "y0", 1),
+           _roller(V, scene, "bottom", 2)]
+    ci = NodalContactInterface(V, scene.facet_tags, *scene.contact_pair, law=LAW, bcs=bcs,
+                               quadrature_degree=2 * order, pairing=pairing, basis=basis,
+                               enforcement=SemismoothNewton())
+    mats = {scene.tag("upper"): Material(E, NU), scene.tag("lower"): Material(E, NU)}
+    problem = ContactProblem(V, mats, bcs,
+                             [SurfaceLoad(scene.tag("top"), traction=[shear, 0, -PRESSURE])],
+                             cell_tags=scene.cell_tags, facet_tags=scene.facet_tags,
+                             interface=ci)
+    return problem, ci
+
+
+def _patch(comm, pairing, cell_type):
+    problem, ci = _blocks(comm, pairing, cell_type)
+    solver = SNESSolver(problem, prefix="test_semismooth_")
+    incs = list(load_path(problem, solver, [0.5, 1.0], verbose=False))
+    pf = ci.point_fields()
+    x = np.concatenate(comm.allgather(ci.point_coordinates()))
+    order = np.lexsort(x.T)
+    out = dict(incs=incs, force=ci.contact_force(),
+               pressure=np.concatenate(comm.allgather(pf.pressure))[order],
+               shear=np.concatenate(comm.allgather(pf.shear))[order],
+               gap=np.concatenate(comm.allgather(pf.gap))[order],
+               slipping=comm.allreduce(int(pf.slipping.sum()), op=MPI.SUM))
+    solver.destroy()
+    return out
+
+
+@pytest.mark.parametrize("pairing,cell", [("conforming", "tetrahedron"),
+                                          ("mortar", "tetrahedron"), ("conforming", "hexahedron")])
+def test_patch_exact_and_rank_independent(pairing, cell):
+    world = _patch(MPI.COMM_WORLD, pairing, cell)
+    assert all(i.cutbacks == 0 and i.newton_total <= 2 for i in world["incs"])
+    np.testing.assert_allclose(world["pressure"], PRESSURE, rtol=0, atol=1e-9 * PRESSURE)
+    assert np.max(np.abs(world["shear"])) <= 1e-9 * PRESSURE and world["slipping"] == 0
+    assert np.max(np.abs(world["gap"])) <= 1e-14      # closed exactly (mm; u ~ 1e-4 mm)
+    np.testing.assert_allclose(world["force"], [0.0, 0.0, PRESSURE], atol=1e-9 * PRESSURE)
+    serial = _patch(MPI.COMM_SELF, pairing, cell)
+    np.testing.assert_allclose(world["pressure"], serial["pressure"], rtol=0,
+                               atol=1e-10 * PRESSURE)
+
+
+def test_condensed_jacobian_against_finite_differences():
+    """J v = (H(u + e v) - H(u - e v)) / 2e at a state with open, sticking and slipping
+    vertices (a random displacement near the contact state; no branch changes within e)."""
+    comm = MPI.COMM_WORLD
+    problem, ci = _blocks(comm, "mortar")
+    problem.set_load_factor(1.0)
+    rng = np.random.default_rng(7 + comm.rank)
+    x = problem.solution_vector().copy()
+    xyz = problem.owned_dof_coordinates()
+    u = x.array.reshape(-1, 3)
+    u[:, 2] = (-1e-4 * (xyz[:, 2] + 0.5) + 1e-3 * (xyz[:, 2] > 0.0) * (xyz[:, 0] - 0.5)
+               + 1e-6 * rng.standard_normal(u.shape[0]))      # tilted: open where x > 0.5
+    u[:, 0] = 1e-6 * rng.standard_normal(u.shape[0])
+    compat.set_bc(x, problem.bcs)
+    b = x.duplicate()
+    problem.F(None, x, b)
+    branches = ci._condensed_iterate
+    n_open, n_slip, n_stick = (comm.allreduce(int(a.sum()), op=MPI.SUM) for a in (
+        ~branches.contact, branches.slipping, branches.contact & ~branches.slipping))
+    assert n_open > 0 and n_slip > 0 and n_stick > 0, (n_open, n_slip, n_stick)
+    problem.J(None, x, problem.A, problem.A)
+    v = x.duplicate()
+    v.array[:] = rng.standard_normal(v.array.size)
+    compat.set_bc(v, problem.bcs)      # Newton never moves a Dirichlet DOF (rollers at 0)
+    Jv = x.duplicate()
+    problem.A.mult(v, Jv)
+    eps = 1e-9
+    H = []
+    for s in (1.0, -1.0):
+        xs = x.copy()
+        xs.axpy(s * eps, v)
+        bs = x.duplicate()
+        problem.F(None, xs, bs)
+        H.append(bs.array.copy())
+        same = (np.array_equal(ci._condensed_iterate.contact, branches.contact)
+                and np.array_equal(ci._condensed_iterate.slipping, branches.slipping))
+        assert comm.allreduce(int(not same), op=MPI.SUM) == 0
+    fd = (H[0] - H[1]) / (2 * eps)
+    scale = comm.allreduce(float(np.abs(fd).max(initial=0.0)), op=MPI.MAX)
+    err = comm.allreduce(float(np.abs(fd - Jv.array).max(initial=0.0)), op=MPI.MAX)
+    assert err <= 1e-6 * scale
+
+
+def _punch(enforcement, comm=MPI.COMM_WORLD):
+    """The coarse punch of tests/fem/test_nodal_ssn.py: dissipation per increment, vertex
+    tractions at the end, Newton iterations."""
+    from rough_contact.scenes import flat_punch
+    law = SoftplusPenalty(k_normal=1e7, width=2.5e-9, k_tangential=1e7, friction=0.2)
+    m = flat_punch.build(comm, mesh_size=20.0, contact_size=2.0, order=1,
+                         load_half_width=10.0, law=law, steps=4, points="nodal", basis="dual",
+                         enforcement=enforcement, prefix="test_semismooth_punch_",
+                         solver_options=dict(linear_solver="mumps"))
+    incs = list(load_path(m.problem, m.solver, load_unload_factors(4, 3, final_factor=0.25)))
+    pf = m.interface.point_fields()
+    x = np.concatenate(comm.allgather(m.interface.point_coordinates()))
+    order = np.lexsort(x.T)
+    t = np.concatenate(comm.allgather(np.column_stack([pf.pressure, pf.shear])))[order]
+    m.solver.destroy()
+    return (np.array([i.dissipation for i in incs]), t, sum(i.newton_total for i in incs),
+            sum(i.cutbacks for i in incs))
+
+
+@pytest.fixture(scope="module")
+def punch_ssn():
+    return _punch(SemismoothNewton())
+
+
+def test_punch_same_answer_as_in_newton_multipliers(punch_ssn):
+    D, t, newton, cutbacks = punch_ssn
+    D_a, t_a, newton_a, _ = _punch(NewtonAugmentedLagrangian(tolerance=1e-8, max_updates=30))
+    assert cutbacks == 0 and D[-1] > 0.0
+    np.testing.assert_allclose(D, D_a, rtol=1e-5, atol=1e-6 * D_a[-1])
+    np.testing.assert_allclose(t, t_a, rtol=0, atol=1e-5 * np.abs(t_a).max())
+    assert newton < newton_a
+
+
+def test_punch_rank_independent(punch_ssn):
+    D, t, _, _ = punch_ssn
+    D_s, t_s, _, _ = _punch(SemismoothNewton(), MPI.COMM_SELF)
+    np.testing.assert_allclose(D, D_s, rtol=1e-10, atol=1e-14)
+    np.testing.assert_allclose(t, t_s, rtol=0, atol=1e-10 * np.abs(t_s).max())
+
+
+@pytest.mark.parametrize("order,basis,match", [(1, "standard", "basis = 'standard'"),
+                                               (2, "dual", "displacement degree 2")])
+def test_refused(order, basis, match):
+    with pytest.raises(ValueError, match=match):
+        _blocks(MPI.COMM_WORLD, "conforming", order=order, basis=basis)
