@@ -442,6 +442,12 @@ class NodalContactInterface(ContactInterface):
         super()._forget()
         self._condensed_iterate = None
 
+    @property
+    def softenable(self) -> bool:
+        """``ContactInterface.softenable``; False with the semismooth Newton, which does not
+        use the law's penalty (a penalty continuation would repeat the same solve)."""
+        return not self.condenses() and super().softenable
+
     def describe(self) -> dict:
         """``ContactInterface.describe`` plus the point set (a checkpoint of the quadrature
         route is not resumed on vertex points, nor the other way round)."""
