@@ -175,3 +175,12 @@ def test_bad_inputs_refused():
         stick_front(r, p, np.array([0.0, -1.0, 0.0, 0.0]), MU, w, st, sl)
     with pytest.raises(ValueError, match="c = 0.3 mm is invalid"):
         mindlin_tractions(r, 0.3, 0.2, P0, MU)
+
+
+def test_scene_refuses_bad_front_arguments():
+    """mindlin.run checks the front's arguments before it builds a mesh."""
+    from rough_contact.scenes import mindlin
+    with pytest.raises(ValueError, match="front_band = 0"):
+        mindlin.run(front_band=0.0)
+    with pytest.raises(ValueError, match="gather_radius = -1"):
+        mindlin.run(gather_radius=-1.0)
