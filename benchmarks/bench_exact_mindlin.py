@@ -135,7 +135,8 @@ def main(argv=None):
     E_star = E / (1.0 - args.nu**2)
     q = r.Q / (r.mu * r.P)
     PETSc.Sys.Print(f"{'t':>6} {'P [N]':>8} {'P/Hertz-1':>9} {'Q/muP':>7} {'c/a MD':>7} "
-                    f"{'area':>7} {'error':>7} {'front':>7} {'error':>7} {'a_FE/a_H':>8} "
+                    f"{'area':>7} {'error':>7} {'front':>7} {'error':>7} {'inside':>7} "
+                    f"{'error':>7} {'a_FE/a_H':>8} "
                     f"{'resid':>6} {'misp':>4} {'D [N mm]':>10} {'Newton':>6}")
     for i in range(r.t.size):
         delta = DELTA * min(r.t[i], 1.0)
@@ -145,6 +146,8 @@ def main(argv=None):
         PETSc.Sys.Print(f"{r.t[i]:6.3f} {r.P[i]:8.3f} {r.P[i] / hertz - 1:+9.4f} {q[i]:7.4f} "
                         f"{ref:7.4f} {r.stick[i]:7.4f} {r.stick[i] / ref - 1:+7.4f} "
                         f"{r.stick_front[i]:7.4f} {r.stick_front[i] / ref - 1:+7.4f} "
+                        f"{r.stick_front_inside[i]:7.4f} "
+                        f"{r.stick_front_inside[i] / ref - 1:+7.4f} "
                         f"{r.contact_radius[i] / a_h:8.4f} {r.front_residual[i]:6.3f} "
                         f"{int(r.front_misplaced[i]):4d} "
                         f"{r.dissipation[i]:10.3e} {int(r.newton[i]):6d}")
@@ -165,7 +168,8 @@ def main(argv=None):
         pts = r.points
         np.savez(args.save, x=pts.x, weight=pts.weight, pressure=pts.pressure, shear=pts.shear,
                  contact=pts.contact, slipping=pts.slipping, t=r.t, P=r.P, Q=r.Q,
-                 stick=r.stick, stick_front=r.stick_front, stick_radius=r.stick_radius,
+                 stick=r.stick, stick_front=r.stick_front,
+                 stick_front_inside=r.stick_front_inside, stick_radius=r.stick_radius,
                  contact_radius=r.contact_radius, mu=r.mu, nu=r.nu, G=r.G)
     PETSc.Sys.Print(f"DOFs {r.dofs}, wall {time.perf_counter() - t0:.0f} s, "
                     f"CPU (rank 0) {time.process_time() - c0:.0f} s")

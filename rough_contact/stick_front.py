@@ -104,7 +104,7 @@ def _array(name: str, value, n=None, dtype=float) -> np.ndarray:
 
 
 def stick_front(r, pressure, shear, mu: float, weights, sticking, slipping, band: float = 0.5,
-                max_iterations: int = 20) -> StickFront:
+                max_iterations: int = 20, inside_slip: bool = False) -> StickFront:
     """Stick radius c of a circular stick zone about r = 0 from the points' margins
     m = mu p - |t| (module docstring): the zero of the weighted least-squares line
     m^2 = A - B r^2 through the stuck points with r >= (1 - band) c.
@@ -120,6 +120,11 @@ def stick_front(r, pressure, shear, mu: float, weights, sticking, slipping, band
             neither are out of contact and ignored).
         band: width of the fitted band as a fraction of c, in (0, 1] (1: all stuck points).
         max_iterations: bound on the band's fixed-point iterations, >= 1.
+        inside_slip: fit only the stuck points closer to the centre than the innermost
+            slipping point: the stick zone proper, without stuck "islands" left among
+            slipping points (a discrete solution's ragged front; in the continuum, monotonic
+            loading keeps the stick zone a disc). Off by default: it assumes the front is
+            nearly circular, since the innermost slipping point bounds it at every azimuth.
 
     Returns:
         :class:`StickFront`.
@@ -161,11 +166,12 @@ def stick_front(r, pressure, shear, mu: float, weights, sticking, slipping, band
     if wbad.any():
         raise ValueError(f"weights = {w[wbad][0]!r} mm^2 at a stuck point is invalid: it must "
                          "be finite and > 0")
-    if not stuck.any():
+    fit = stuck & (r < r[slip].min()) if inside_slip and slip.any() else stuck
+    if not fit.any():
         return StickFront(0.0, np.nan, 0, 0, 0)
-    rs = r[stuck]
-    m2 = np.maximum(mu * p[stuck] - t[stuck], 0.0) ** 2
-    ws = w[stuck]
+    rs = r[fit]
+    m2 = np.maximum(mu * p[fit] - t[fit], 0.0) ** 2
+    ws = w[fit]
     r2 = rs**2
     chosen = np.ones(rs.size, dtype=bool)             # first fit: every stuck point
     c2, rel = np.nan, np.nan

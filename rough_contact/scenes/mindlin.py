@@ -138,6 +138,9 @@ class MindlinRun:
             stick_front.contact_front`: zeros of m^2 = (mu p - |t|)^2 and of p^2 fitted
             against r^2 next to the fronts, finer than the point spacing) [-] (nan where a
             front cannot be fitted, 0 when no point sticks).
+        stick_front_inside: the same with only the stuck points inside the innermost slipping
+            point fitted (``stick_front(inside_slip=True)``: without the stuck islands a
+            discrete solution leaves among slipping points) [-].
         stick_radius, contact_radius: c and a_FE of ``stick_front`` [mm].
         front_residual: relative rms residual of the margin fit [-].
         front_misplaced: stuck points beyond c plus slipping points inside c.
@@ -167,6 +170,7 @@ class MindlinRun:
     cycle_start: Optional[float]
     shear_steps: int
     stick_front: Optional[np.ndarray] = None
+    stick_front_inside: Optional[np.ndarray] = None
     stick_radius: Optional[np.ndarray] = None
     contact_radius: Optional[np.ndarray] = None
     front_residual: Optional[np.ndarray] = None
@@ -341,12 +345,15 @@ def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5
         cf = contact_front(r_g, p_g, w_g, on, band=front_band)
         sf = stick_front(r_g, p_g, np.linalg.norm(t_g, axis=1), mu, w_g, on & ~slip_g,
                          on & slip_g, band=front_band)
+        si = stick_front(r_g, p_g, np.linalg.norm(t_g, axis=1), mu, w_g, on & ~slip_g,
+                         on & slip_g, band=front_band, inside_slip=True)
         ratio = sf.radius / cf.radius if cf.radius > 0 else float("nan")
+        ratio_in = si.radius / cf.radius if cf.radius > 0 else float("nan")
         rows.append((inc.load_factor, problem.scales["shear"] * slide, 2.0 * R[2], 2.0 * R[0],
                      stick, 2.0 * A_c, 2.0 * inc.dissipation, inc.newton_total, ratio,
-                     sf.radius, cf.radius, sf.residual, sf.n_misplaced))
+                     sf.radius, cf.radius, sf.residual, sf.n_misplaced, ratio_in))
     solver.destroy()
-    t, s, P, Q, stick, area, D, newton, front, c_r, a_r, res, mis = \
+    t, s, P, Q, stick, area, D, newton, front, c_r, a_r, res, mis, front_in = \
         (np.array(c) for c in zip(*rows))
     S = np.array(snaps)
     on_all = S[:, :, 5] > 0.5
@@ -355,6 +362,7 @@ def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5
     return MindlinRun(t=t, slide=s, P=P, Q=Q, stick=stick, contact_area=area, dissipation=D,
                       newton=newton, a=hertz_radius(P[-1], radius, E_star), G=G, nu=nu, mu=mu,
                       dofs=problem.num_dofs, cycle_start=prog.cycle_start,
-                      shear_steps=shear_steps, stick_front=front, stick_radius=c_r,
+                      shear_steps=shear_steps, stick_front=front,
+                      stick_front_inside=front_in, stick_radius=c_r,
                       contact_radius=a_r, front_residual=res, front_misplaced=mis.astype(int),
                       points=points)

@@ -119,6 +119,29 @@ def test_generic_square_root_margin_bias_shrinks_with_the_band():
             assert abs(e) < abs(k) * b * b / (3.0 * (1.0 - abs(k))), (k, b, e)
 
 
+def test_stuck_islands_among_slipping_points():
+    """Stuck points left in the slip annulus (a ragged discrete front) with a small margin pull
+    the plain fit outwards; ``inside_slip`` fits the stick zone proper and returns c again."""
+    r, w = lattice(A / 8, 1.5 * A, seed=5)
+    c = 0.6 * A
+    p, t, st, sl = mindlin_tractions(r, c, A, P0, MU)
+    islands = np.flatnonzero(sl & (r < c + 0.3 * A))[::3]       # every third annulus point
+    st, sl = st.copy(), sl.copy()
+    st[islands], sl[islands] = True, False
+    t = t.copy()
+    t[islands] = MU * p[islands] * (1.0 - 0.05)                  # a margin of 5 % of mu p
+    plain = stick_front(r, p, t, MU, w, st, sl)
+    inner = stick_front(r, p, t, MU, w, st, sl, inside_slip=True)
+    assert plain.radius > 1.01 * c
+    assert plain.n_misplaced >= islands.size
+    assert inner.radius == pytest.approx(c, rel=1e-10)
+    # without slipping points the option changes nothing
+    none = np.zeros(r.size, dtype=bool)
+    p, t, st, _ = mindlin_tractions(r, A, A, P0, MU)
+    assert stick_front(r, p, t, MU, w, st, none, inside_slip=True).radius == \
+        pytest.approx(A, rel=1e-10)
+
+
 def test_order_of_the_points_does_not_matter():
     r, w = lattice(A / 8, 1.5 * A, seed=11)
     p, t, st, sl = mindlin_tractions(r, 0.7 * A, A, P0, MU)
