@@ -183,7 +183,10 @@ def _gather_points(comm, x, arrays):
     x, y, z (an order independent of the partition)."""
     xs = np.concatenate(comm.allgather(np.asarray(x, dtype=float)))
     data = np.concatenate(comm.allgather(np.asarray(arrays, dtype=float)))
-    order = np.lexsort((xs[:, 2], xs[:, 1], xs[:, 0]))
+    # the mesh's distribution perturbs coordinates by rounding (1e-16 mm): sort on keys rounded
+    # well above it, so that a partition cannot swap two points of the same x
+    key = np.round(xs / max(float(np.abs(xs).max(initial=0.0)), 1e-300), 9)
+    order = np.lexsort((key[:, 2], key[:, 1], key[:, 0]))
     return xs[order], data[order]
 
 
