@@ -13,7 +13,10 @@ total forces are twice the bottom reactions. The stick radius of the FE solution
 from areas, c / a = sqrt(1 - A_slip / A_contact) (A = nominal areas of the slipping and of the
 contact points, contact meaning p > 1e-3 p_max: the softplus law is positive everywhere): an
 area average, less sensitive to the point spacing than the radius of the outermost stuck
-point.
+point, but it moves by a whole ring of points when the front crosses one. Beside it, the front
+estimate c / a_FE (:mod:`rough_contact.stick_front`): the zeros of the squared stick margin
+(mu p - |t|)^2 and of p^2, each fitted against r^2 next to its front over the points gathered
+from every rank (``MindlinRun.points``), finer than the point spacing (docs/mindlin_dual.md).
 
 Units: mm, N, MPa.
 """
