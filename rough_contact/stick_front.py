@@ -24,11 +24,16 @@ are not fitted.
 Which band. Near the front the square-root law is a local (leading-order) statement; in
 Mindlin's solution it holds everywhere, in a general problem only close to the front. The
 band is the stuck points with r >= (1 - band) c, found by a fixed point (start from all stuck
-points, fit, take the band of that c, fit again, until the band stops changing); the default
-half of the stick radius keeps several rings of points at the spacings met in practice
-(contact radius / 4 … / 16) while staying where the leading-order law applies. A discrete
-solution's margins are least accurate at the point nearest to the front; the fit pools all of
-the band, so one such point moves c by a fraction of a ring, not by a ring.
+points, fit, take the band of that c, fit again, until the band stops changing); the default,
+half of the stick radius, holds two or more rings of points at spacings of a/8 and finer
+down to c = a/2 (one ring or less at a/4 and small c). Where the margin is not Mindlin's,
+m^2 = (c^2 - r^2) g(r^2) with g varying, the line is a secant and c moves by about
+k band^2 / (3 (1 + k)) for g = 1 + k r^2 / c^2 (second order in the band; the unit tests derive
+and check it), so the spread of c over bands is the warning sign. A discrete solution's
+margins are least accurate at the point nearest to the front; the fit pools all of the band,
+so one such point moves c by a fraction of a ring, not by a ring. ``inside_slip`` fits only
+the stuck points inside the innermost slipping one (a ragged discrete front leaves stuck
+islands among slipping points, which pull the line outwards).
 
 The estimator uses no constant of Mindlin's (p0, a, mu P): only the points' radii from the
 centre of the contact, their pressure, shear magnitude, the friction coefficient, their
