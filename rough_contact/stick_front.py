@@ -64,8 +64,8 @@ class StickFront:
 
     Attributes:
         radius: stick radius c (0 when no point sticks; nan when too few stuck points to fit
-            a line (fewer than 3 at distinct radii) or when the fitted m^2 does not fall
-            outwards) [mm].
+            a line (fewer than 2 at distinct radii) or when the fitted m^2 does not fall
+            outwards, in the band nor over all stuck points) [mm].
         residual: weighted rms residual of the line m^2 = A - B r^2 over the band, divided by
             the weighted rms of m^2 there [-] (nan without a fit).
         n_band: number of stuck points fitted.
@@ -154,7 +154,7 @@ def stick_front(r, pressure, shear, mu: float, weights, sticking, slipping, band
                          "integer >= 1")
     bad = ~np.isfinite(r) | (r < 0.0)
     if bad.any():
-        raise ValueError(f"r = {r[bad][0]!r} mm is invalid: radii must be finite and >= 0")
+        raise ValueError(f"r = {float(r[bad][0])!r} mm is invalid: radii must be finite and >= 0")
     both = stuck & slip
     if both.any():
         raise ValueError(f"point {int(np.flatnonzero(both)[0])} is both sticking and slipping: "
@@ -162,15 +162,15 @@ def stick_front(r, pressure, shear, mu: float, weights, sticking, slipping, band
     for name, a in (("pressure", p), ("shear", t)):
         nonfinite = stuck & ~np.isfinite(a)
         if nonfinite.any():
-            raise ValueError(f"{name} = {a[nonfinite][0]!r} MPa at a stuck point is invalid: "
-                             "it must be finite")
+            raise ValueError(f"{name} = {float(a[nonfinite][0])!r} MPa at a stuck point is "
+                             "invalid: it must be finite")
     if np.any(t[np.isfinite(t)] < 0.0):
-        raise ValueError(f"shear = {t[np.isfinite(t)].min()!r} MPa is invalid: it is the "
+        raise ValueError(f"shear = {float(t[np.isfinite(t)].min())!r} MPa is invalid: it is the "
                          "magnitude |t| >= 0")
     wbad = stuck & ~(np.isfinite(w) & (w > 0.0))
     if wbad.any():
-        raise ValueError(f"weights = {w[wbad][0]!r} mm^2 at a stuck point is invalid: it must "
-                         "be finite and > 0")
+        raise ValueError(f"weights = {float(w[wbad][0])!r} mm^2 at a stuck point is invalid: "
+                         "it must be finite and > 0")
     fit = stuck & (r < r[slip].min()) if inside_slip and slip.any() else stuck
     if not fit.any():
         return StickFront(0.0, np.nan, 0, 0, 0)
@@ -186,6 +186,12 @@ def stick_front(r, pressure, shear, mu: float, weights, sticking, slipping, band
             c2, rel = np.nan, np.nan
             break
         c2, rel = _fit(r2[chosen], m2[chosen], ws[chosen])
+        if (not np.isfinite(c2) or c2 <= 0.0) and not chosen.all():
+            # a band too narrow for the points' scatter (e.g. one ring): all stuck points
+            chosen = np.ones(rs.size, dtype=bool)
+            c2, rel = _fit(r2, m2, ws)
+            if np.isfinite(c2) and c2 > 0.0:
+                break
         if not np.isfinite(c2) or c2 <= 0.0:
             c2 = np.nan
             break

@@ -49,8 +49,8 @@ def test_stick_front_is_the_estimator_on_the_gathered_points(run):
         t = np.linalg.norm(pts.shear[i], axis=1)
         a = contact_front(r, pts.pressure[i], pts.weight, on).radius
         c = stick_front(r, pts.pressure[i], t, run.mu, pts.weight, on & ~sl, sl).radius
-        assert run.contact_radius[i] == a and run.stick_radius[i] == c
-        assert run.stick_front[i] == pytest.approx(c / a, rel=1e-15)
+        np.testing.assert_equal([run.contact_radius[i], run.stick_radius[i]], [a, c])
+        np.testing.assert_allclose(run.stick_front[i], c / a, rtol=1e-15)
     # gross slip at the end: no stuck point, c = 0; partial slip before it
     assert run.stick_front[-1] == 0.0 and not (pts.contact[-1] & ~pts.slipping[-1]).any()
     assert 0.0 < run.stick_front[-2] < 1.0

@@ -207,3 +207,20 @@ def test_scene_refuses_bad_front_arguments():
         mindlin.run(front_band=0.0)
     with pytest.raises(ValueError, match="gather_radius = -1"):
         mindlin.run(gather_radius=-1.0)
+
+
+def test_band_of_one_ring_falls_back_to_all_stuck_points():
+    """A coarse stick zone: the centre point and one ring whose margins scatter more than they
+    fall across the ring's small spread of radii (the state of a tiny P2 run, contact elements
+    a/2, at Q/mu P = 0.67, rounded). The band of the first fit holds only the ring, where the
+    line rises; the estimate then uses every stuck point instead of giving up."""
+    r = np.array([0.0, 0.097550, 0.097550, 0.097972, 0.098600, 0.1696, 0.1951])
+    p = np.array([3258.1, 2841.1, 2855.3, 2863.8, 2818.9, 1711.1, 1073.0])
+    t = np.array([239.37, 443.05, 419.48, 309.25, 396.07, 513.33, 321.89])
+    w = np.array([0.00416, 0.00414, 0.00416, 0.00840, 0.00834, 0.00826, 0.00412])
+    st = np.array([True] * 5 + [False] * 2)
+    ring = stick_front(r[1:], p[1:], t[1:], MU, w[1:], st[1:], ~st[1:], band=1.0)
+    assert np.isnan(ring.radius)                     # the ring alone: m^2 does not fall
+    f = stick_front(r, p, t, MU, w, st, ~st)
+    assert np.isfinite(f.radius) and r[4] < f.radius < r[5]
+    assert f.n_band == 5
