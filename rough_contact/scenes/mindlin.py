@@ -13,7 +13,10 @@ total forces are twice the bottom reactions. The stick radius of the FE solution
 from areas, c / a = sqrt(1 - A_slip / A_contact) (A = nominal areas of the slipping and of the
 contact points, contact meaning p > 1e-3 p_max: the softplus law is positive everywhere): an
 area average, less sensitive to the point spacing than the radius of the outermost stuck
-point.
+point, but it moves by a whole ring of points when the front crosses one. Beside it, the front
+estimate c / a_FE (:mod:`rough_contact.stick_front`): the zeros of the squared stick margin
+(mu p - |t|)^2 and of p^2, each fitted against r^2 next to its front over the points gathered
+from every rank (``MindlinRun.points``), finer than the point spacing (docs/mindlin_dual.md).
 
 Units: mm, N, MPa.
 """
@@ -42,9 +45,10 @@ from rough_contact.scenes.setup import check_points_basis
 from rough_contact.solver.loading import load_path
 from rough_contact.solver.program import LoadProgram
 from rough_contact.solver.snes import SNESSolver
+from rough_contact.stick_front import contact_front, stick_front
 from rough_contact.validation import check_scalar
 
-__all__ = ["ParaboloidIndenter", "KT_SCALE", "MindlinRun", "run"]
+__all__ = ["ParaboloidIndenter", "KT_SCALE", "MindlinRun", "PointSnapshot", "run"]
 
 
 class ParaboloidIndenter:
@@ -95,6 +99,34 @@ def _program(preload_steps: int, shear_steps: int, cycles: int) -> LoadProgram:
 
 
 @dataclass(frozen=True)
+class PointSnapshot:
+    """The interface points near the contact (within ``gather_radius`` of the axis), gathered
+    from every rank and sorted by their coordinates (the same arrays whatever the partition);
+    per-increment arrays have one row per increment.
+
+    Attributes:
+        x: (n, 3) reference coordinates [mm] (the half model: y >= 0).
+        weight: (n,) area each point represents [mm^2].
+        pressure: (n_inc, n) p [MPa].
+        shear: (n_inc, n, 2) (t_x, t_y) [MPa].
+        contact: (n_inc, n) bool: p > 1e-3 of the increment's largest p (the scene's contact).
+        slipping: (n_inc, n) bool: in contact and slipping.
+    """
+
+    x: np.ndarray
+    weight: np.ndarray
+    pressure: np.ndarray
+    shear: np.ndarray
+    contact: np.ndarray
+    slipping: np.ndarray
+
+    @property
+    def r(self) -> np.ndarray:
+        """(n,) distance from the axis of the indenter [mm]."""
+        return np.hypot(self.x[:, 0], self.x[:, 1])
+
+
+@dataclass(frozen=True)
 class MindlinRun:
     """Result of :func:`run` (identical on every rank); arrays have one entry per increment.
 
@@ -102,7 +134,19 @@ class MindlinRun:
         t: pseudo-time (normal ramp over [0, 1], then the shear).
         slide: bottom displacement along x [mm].
         P, Q: total normal and tangential force (twice the half model's bottom reactions) [N].
-        stick: FE stick ratio sqrt(1 - A_slip / A_contact) [-] (nan without contact).
+        stick: FE stick ratio sqrt(1 - A_slip / A_contact) [-] (nan without contact): the
+            area estimate, which moves by a whole ring of points when the front crosses one.
+        stick_front: FE stick ratio c / a_FE from the fronts of the margins and of the
+            pressure (:func:`rough_contact.stick_front.stick_front`, :func:`~rough_contact.
+            stick_front.contact_front`: zeros of m^2 = (mu p - |t|)^2 and of p^2 fitted
+            against r^2 next to the fronts, finer than the point spacing) [-] (nan where a
+            front cannot be fitted, 0 when no point sticks).
+        stick_front_inside: the same with only the stuck points inside the innermost slipping
+            point fitted (``stick_front(inside_slip=True)``: without the stuck islands a
+            discrete solution leaves among slipping points) [-].
+        stick_radius, contact_radius: c and a_FE of ``stick_front`` [mm].
+        front_residual: relative rms residual of the margin fit [-].
+        front_misplaced: stuck points beyond c plus slipping points inside c.
         contact_area: nominal area with p > 1e-3 p_max (whole contact) [mm^2].
         dissipation: committed dissipation (whole contact) [N mm].
         newton: Newton iterations spent on each increment.
@@ -128,6 +172,25 @@ class MindlinRun:
     dofs: int
     cycle_start: Optional[float]
     shear_steps: int
+    stick_front: Optional[np.ndarray] = None
+    stick_front_inside: Optional[np.ndarray] = None
+    stick_radius: Optional[np.ndarray] = None
+    contact_radius: Optional[np.ndarray] = None
+    front_residual: Optional[np.ndarray] = None
+    front_misplaced: Optional[np.ndarray] = None
+    points: Optional[PointSnapshot] = None
+
+
+def _gather_points(comm, x, arrays):
+    """Every rank's rows of ``x`` (n, 3) and of the (n, k) ``arrays`` on every rank, sorted by
+    x, y, z (an order independent of the partition)."""
+    xs = np.concatenate(comm.allgather(np.asarray(x, dtype=float)))
+    data = np.concatenate(comm.allgather(np.asarray(arrays, dtype=float)))
+    # the mesh's distribution perturbs coordinates by rounding (1e-16 mm): sort on keys rounded
+    # well above it, so that a partition cannot swap two points of the same x
+    key = np.round(xs / max(float(np.abs(xs).max(initial=0.0)), 1e-300), 9)
+    order = np.lexsort((key[:, 2], key[:, 1], key[:, 0]))
+    return xs[order], data[order]
 
 
 def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5, nu=0.49,
@@ -135,7 +198,7 @@ def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5
         shear_steps=12, cycles=0, indenter="paraboloid", quadrature_degree=None,
         k_tangential=None, ring_size=None, ring_band=(0.8, 1.05), width_ratio=1e-3,
         augmented=False, augmentation_tolerance=1e-3, points="quadrature", transition=1.0,
-        refined_radius=0.4,
+        refined_radius=0.4, gather_radius=1.5, front_band=0.5,
         max_updates=30, basis="standard", enforcement=None, comm=MPI.COMM_WORLD,
         verbose=False) -> MindlinRun:
     """Normal indentation by ``delta`` [mm], then a tangential bottom displacement: monotonic to
@@ -187,6 +250,11 @@ def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5
     Newton iteration, nodal points only); default ``None``: chosen by ``augmented``. Giving
     both ``enforcement`` and ``augmented=True`` is an error.
 
+    ``gather_radius``: the points within ``gather_radius`` x sqrt(R delta) (Hertz's radius at
+    ``delta``) of the axis are gathered at every increment (``MindlinRun.points``) and give the
+    front estimate ``MindlinRun.stick_front``; ``front_band``: its fitted band, a fraction of
+    each front's radius (:func:`rough_contact.stick_front.stick_front`).
+
     ``slide`` defaults to the approach at which Mindlin's Q reaches mu P for Hertz's P at
     ``delta`` plus the block's shear compliance (so the last increments slide).
 
@@ -212,6 +280,9 @@ def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5
         slide = sliding_approach(mu, P_h, a_h, G, nu) + \
             mu * P_h * height / (G * 2.0 * half_width * half_width)
     check_scalar("slide", slide, lo=0.0, unit="mm")
+    check_scalar("gather_radius", gather_radius, lo=0.0)
+    check_scalar("front_band", front_band, lo=0.0, hi=1.0, hi_open=False)
+    r_gather = gather_radius * np.sqrt(radius * delta)
     ring = None
     if ring_size is not None:
         lo, hi = ring_band
@@ -254,23 +325,50 @@ def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5
                     PrescribedDisplacement(bottom, (slide, 0.0, 0.0), (0,), channel="shear")],
         programs=prog.channels)
     solver = SNESSolver(problem, prefix="mindlin_")
-    rows = []
+    rows, snaps = [], []
+    x_near = None
     for inc in load_path(problem, solver, prog.times, verbose=verbose):
         R = problem.reaction(bottom)
         pf = ci.point_fields()
+        x_loc = ci.point_coordinates()
+        near = (np.hypot(x_loc[:, 0], x_loc[:, 1]) < r_gather) & (pf.weight > 0.0)
+        x_near, cols = _gather_points(comm, x_loc[near], np.column_stack([
+            pf.weight[near], pf.pressure[near], pf.shear[near],
+            pf.slipping[near].astype(float)]))
+        p_max = comm.allreduce(float(pf.pressure.max(initial=0.0)), op=MPI.MAX)
+        snaps.append(np.column_stack([cols, cols[:, 1] > 1e-3 * p_max]))
         # contact: p above 1e-3 of the peak (the softplus law is positive everywhere; Hertz's
         # p reaches 1e-3 p0 within 5e-7 a of the edge)
-        p_max = comm.allreduce(float(pf.pressure.max(initial=0.0)), op=MPI.MAX)
         touching = pf.pressure > 1e-3 * p_max
         A_c, A_s = comm.allreduce(np.array([pf.weight[touching].sum(),
                                             pf.weight[touching & pf.slipping].sum()]),
                                   op=MPI.SUM)
         stick = float(np.sqrt(max(1.0 - A_s / A_c, 0.0))) if A_c > 0 else float("nan")
+        # the front estimates, on the gathered points (the same arrays on every rank)
+        w_g, p_g, t_g, slip_g = cols[:, 0], cols[:, 1], cols[:, 2:4], cols[:, 4] > 0.5
+        r_g = np.hypot(x_near[:, 0], x_near[:, 1])
+        on = p_g > 1e-3 * p_max
+        cf = contact_front(r_g, p_g, w_g, on, band=front_band)
+        sf = stick_front(r_g, p_g, np.linalg.norm(t_g, axis=1), mu, w_g, on & ~slip_g,
+                         on & slip_g, band=front_band)
+        si = stick_front(r_g, p_g, np.linalg.norm(t_g, axis=1), mu, w_g, on & ~slip_g,
+                         on & slip_g, band=front_band, inside_slip=True)
+        ratio = sf.radius / cf.radius if cf.radius > 0 else float("nan")
+        ratio_in = si.radius / cf.radius if cf.radius > 0 else float("nan")
         rows.append((inc.load_factor, problem.scales["shear"] * slide, 2.0 * R[2], 2.0 * R[0],
-                     stick, 2.0 * A_c, 2.0 * inc.dissipation, inc.newton_total))
+                     stick, 2.0 * A_c, 2.0 * inc.dissipation, inc.newton_total, ratio,
+                     sf.radius, cf.radius, sf.residual, sf.n_misplaced, ratio_in))
     solver.destroy()
-    t, s, P, Q, stick, area, D, newton = (np.array(c) for c in zip(*rows))
+    t, s, P, Q, stick, area, D, newton, front, c_r, a_r, res, mis, front_in = \
+        (np.array(c) for c in zip(*rows))
+    S = np.array(snaps)
+    on_all = S[:, :, 5] > 0.5
+    points = PointSnapshot(x=x_near, weight=S[0, :, 0], pressure=S[:, :, 1], shear=S[:, :, 2:4],
+                           contact=on_all, slipping=on_all & (S[:, :, 4] > 0.5))
     return MindlinRun(t=t, slide=s, P=P, Q=Q, stick=stick, contact_area=area, dissipation=D,
                       newton=newton, a=hertz_radius(P[-1], radius, E_star), G=G, nu=nu, mu=mu,
                       dofs=problem.num_dofs, cycle_start=prog.cycle_start,
-                      shear_steps=shear_steps)
+                      shear_steps=shear_steps, stick_front=front,
+                      stick_front_inside=front_in, stick_radius=c_r,
+                      contact_radius=a_r, front_residual=res, front_misplaced=mis.astype(int),
+                      points=points)
