@@ -564,6 +564,14 @@ class ContactProblem:
             P.assemble()
 
     # ------------------------------------------------------------------ helpers
+    @property
+    def condensed(self) -> bool:
+        """Whether the interface's enforcement condenses the contact tractions into the
+        system (``rough_contact.fem.condensation.CondensedInterface``; the semismooth Newton):
+        the Jacobian is then unsymmetric with constraint rows (``SNESSolver`` uses a direct
+        solver)."""
+        return self._condensed
+
     def n_in_contact(self) -> int:
         """Global number of interface points in contact at the last evaluation (collective)."""
         return 0 if self.interface is None else self.interface.n_contact()

@@ -225,10 +225,15 @@ def _reason_name(reason: int) -> str:
 
 
 def _choose_linear_solver(cmd, prefix: str, n: int, dof_threshold: Optional[int],
-                          linear_solver: str) -> tuple[int, str]:
+                          linear_solver: str, condensed: bool = False) -> tuple[int, str]:
     """(the DOF threshold, the option set's name): the command line's ``-PREFIXdof_threshold``
     and ``-PREFIXlinear_solver`` override the arguments; ``"auto"`` takes the set of a given
-    ``-PREFIXpc_type``, else MUMPS up to the threshold and algebraic multigrid above it."""
+    ``-PREFIXpc_type``, else MUMPS up to the threshold and algebraic multigrid above it.
+
+    ``condensed`` (the semismooth Newton's system, ``ContactProblem.condensed``): its
+    constraint rows have no elastic diagonal, which the AMG preconditioners cannot handle
+    (measured: hypre's GMRES diverges at the first solve of the punch); ``"auto"`` is MUMPS at
+    any size, and an AMG set is refused."""
     if cmd.hasName(prefix + "dof_threshold"):
         dof_threshold = cmd.getInt(prefix + "dof_threshold")
     if dof_threshold is None:
@@ -245,8 +250,15 @@ def _choose_linear_solver(cmd, prefix: str, n: int, dof_threshold: Optional[int]
         if pc_user is not None:
             linear_solver = {"lu": "mumps", "cholesky": "mumps", "gamg": "gamg",
                              "hypre": "hypre"}.get(pc_user, "krylov")
+        elif condensed:
+            linear_solver = "mumps"
         else:
             linear_solver = "mumps" if n <= int(dof_threshold) else AMG_DEFAULT
+    if condensed and linear_solver in ("gamg", "hypre"):
+        raise ValueError(f"linear solver = {linear_solver!r} is invalid for the semismooth "
+                         "Newton's condensed system (rows of contact constraints without an "
+                         "elastic diagonal defeat algebraic multigrid); valid: 'mumps', "
+                         "'mumps_lagged', 'krylov' with an LU preconditioner, or 'auto'")
     return int(dof_threshold), linear_solver
 
 
@@ -306,7 +318,7 @@ class SNESSolver:
         comm = problem.comm
         cmd = PETSc.Options()
         self.dof_threshold, linear_solver = _choose_linear_solver(
-            cmd, prefix, problem.num_dofs, dof_threshold, linear_solver)
+            cmd, prefix, problem.num_dofs, dof_threshold, linear_solver, problem.condensed)
         self.option_set = linear_solver
         if cmd.hasName(prefix + "continuation"):
             continuation = _parse_continuation(cmd.getString(prefix + "continuation"))

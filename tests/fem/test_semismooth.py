@@ -184,3 +184,18 @@ def test_punch_rank_independent(punch_ssn):
 def test_refused(order, basis, match):
     with pytest.raises(ValueError, match=match):
         _blocks(MPI.COMM_WORLD, "conforming", order=order, basis=basis)
+
+
+def test_direct_solver_at_any_size_and_amg_refused():
+    """The condensed system has constraint rows without an elastic diagonal: the size rule
+    keeps MUMPS above its threshold, and an AMG set is refused naming it (hypre's GMRES
+    diverged at the punch's first solve)."""
+    problem, _ = _blocks(MPI.COMM_WORLD, "conforming")
+    assert problem.condensed
+    solver = SNESSolver(problem, prefix="test_semismooth_size_", dof_threshold=0)
+    assert solver.option_set == "mumps"
+    solver.destroy()
+    for name in ("hypre", "gamg"):
+        with pytest.raises(ValueError, match=f"linear solver = '{name}' is invalid for the "
+                                             "semismooth"):
+            SNESSolver(problem, prefix="test_semismooth_amg_", linear_solver=name)
