@@ -12,8 +12,8 @@ relative to the largest traction (about 1 for a penalty, the tolerance for exact
 
     OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bench_coulomb_punch.py \\
         [--levels 1 2 3] [--mu 0.2 0.5] [--k 1e7] [--predictor none secant]
-        [--quadrature gauss vertex nodal] [--reversal-stiffness 0 1] [--augmented 0 1 2]
-        [--al-tol 1e-3] [--basis standard dual] [--residual-ratio 1e-2]
+        [--quadrature gauss vertex nodal] [--reversal-stiffness 0 1] [--augmented 0 1 2 3]
+        [--al-tol 1e-3] [--basis standard dual] [--residual-ratio 1e-2] [--ssn-r R]
         [--continuation none 100,10] [--after 10] [--linear-solver auto mumps hypre] [--csv FILE]
         [--mesh-size H] [--contact-size HC]
 
@@ -177,9 +177,10 @@ def main(argv=None):
     ap.add_argument("--reversal-stiffness", type=float, nargs="+", default=[1.0],
                     help="SoftplusPenalty.reversal_stiffness (0 = consistent tangent everywhere)")
     ap.add_argument("--augmented", type=int, nargs="+", default=[0], choices=[0, 1, 2, 3],
-                    help="1 = augmented Lagrangian (Uzawa) on top of the penalty; 3 = Alart-Curnier's "
-                    "semismooth Newton with the tractions condensed (SemismoothNewton: --quadrature "
-                    "nodal --basis dual, P1; augmentation = --k); 2 = the "
+                    help="1 = augmented Lagrangian (Uzawa) on top of the penalty; 3 = "
+                    "Alart-Curnier's semismooth Newton with the tractions condensed "
+                    "(SemismoothNewton: --quadrature nodal --basis dual, P1; augmentation: "
+                    "--ssn-r); 2 = the "
                     "multipliers updated inside the Newton iteration (NewtonAugmentedLagrangian, "
                     "--quadrature nodal only)")
     ap.add_argument("--al-tol", type=float, default=1e-3,

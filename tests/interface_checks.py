@@ -1,16 +1,41 @@
 """Shared FE test helper: a contact interface's force, residual and Jacobian figures at one
 state, and the Jacobian checked against central differences of the residual.
 
-Imported by tests/fem/test_nodal.py and tests/fem/test_nonmatching.py (which put this folder on
-sys.path). Collective: every rank calls it.
+Also the two blocks on rollers that the nodal and semismooth tests press together.
+
+Imported by tests/fem/test_nodal.py, test_nonmatching.py, test_nodal_ssn.py and
+test_semismooth.py (which put this folder on sys.path). Collective: every rank calls it.
 """
 from __future__ import annotations
 
 import numpy as np
 import ufl
+from petsc4py import PETSc
 
 from dolfinx import fem
 from rough_contact.fem import compat
+from rough_contact.scenes.meshes.blocks import separate_blocks, two_blocks
+
+
+def roller(V, scene, name, comp):
+    """u[comp] = 0 on the facets tagged ``name``."""
+    facets = scene.facet_tags.find(scene.tag(name))
+    dofs = fem.locate_dofs_topological(V.sub(comp), 2, facets)
+    return fem.dirichletbc(PETSc.ScalarType(0.0), dofs, V.sub(comp))
+
+
+def blocks_on_rollers(comm, pairing, order, cell_type="tetrahedron"):
+    """(scene, V, bcs): two blocks, conforming (one mesh, h = 0.3) or not (``separate_blocks``,
+    h = 0.2 and 0.28), on rollers x = 0, y = 0 and the bottom."""
+    if pairing == "conforming":
+        scene = two_blocks(h1=1.0, h2=0.5, mesh_size=0.3, order=order, comm=comm,
+                           cell_type=cell_type)
+    else:
+        scene = separate_blocks(h1=1.0, h2=0.5, size_lower=0.2, size_upper=0.28, order=order,
+                                comm=comm, cell_type=cell_type)
+    V = compat.vector_space(scene.mesh, order)
+    bcs = [roller(V, scene, "x0", 0), roller(V, scene, "y0", 1), roller(V, scene, "bottom", 2)]
+    return scene, V, bcs
 
 
 def residual_jacobian_figures(ci, u, V, fd: bool = False):

@@ -34,7 +34,8 @@ from typing import Optional, Protocol, Union, runtime_checkable
 import numpy as np
 
 from ..validation import check_scalar
-from .contract import CoulombContactLaw, CoulombLimit, InterfaceLawProtocol, LawResult, MultiplierLaw
+from .contract import (CoulombContactLaw, CoulombLimit, InterfaceLawProtocol, LawResult,
+                       MultiplierLaw)
 
 __all__ = ["Enforcement", "Penalty", "AugmentedLagrangian", "NewtonAugmentedLagrangian",
            "SemismoothNewton", "MultiplierUpdate"]

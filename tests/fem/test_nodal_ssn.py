@@ -18,43 +18,32 @@ Run serial and in parallel:
 
 from __future__ import annotations
 
+import sys
+from pathlib import Path
+
 import numpy as np
 import pytest
 from mpi4py import MPI
-from petsc4py import PETSc
 
-from dolfinx import fem
-from rough_contact.fem import compat
 from rough_contact.fem.nodal import NodalContactInterface
 from rough_contact.fem.problem import ContactProblem, Material, SurfaceLoad
 from rough_contact.interface.enforcement import (AugmentedLagrangian, NewtonAugmentedLagrangian,
                                                  Penalty)
 from rough_contact.interface.penalty import SoftplusPenalty
-from rough_contact.scenes.meshes.blocks import separate_blocks, two_blocks
 from rough_contact.solver.loading import load_path
 from rough_contact.solver.snes import SNESSolver
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))   # tests/: shared checks
+from interface_checks import blocks_on_rollers  # noqa: E402
 
 E, NU, PRESSURE, MU = 2.0e5, 0.25, 80.0, 0.3
 K = 1e6          # penalty k_N = k_T [MPa/mm]
 
 
-def _roller(V, scene, name, comp):
-    facets = scene.facet_tags.find(scene.tag(name))
-    dofs = fem.locate_dofs_topological(V.sub(comp), 2, facets)
-    return fem.dirichletbc(PETSc.ScalarType(0.0), dofs, V.sub(comp))
-
 
 def _patch(comm, pairing, order, basis="standard", cell_type="tetrahedron"):
     """Uniform pressure on the top of two blocks on rollers, one increment."""
-    if pairing == "conforming":
-        scene = two_blocks(h1=1.0, h2=0.5, mesh_size=0.3, order=order, comm=comm,
-                           cell_type=cell_type)
-    else:
-        scene = separate_blocks(h1=1.0, h2=0.5, size_lower=0.2, size_upper=0.28, order=order,
-                                comm=comm, cell_type=cell_type)
-    V = compat.vector_space(scene.mesh, order)
-    bcs = [_roller(V, scene, "x0", 0), _roller(V, scene, "y0", 1),
-           _roller(V, scene, "bottom", 2)]
+    scene, V, bcs = blocks_on_rollers(comm, pairing, order, cell_type)
     law = SoftplusPenalty(K, 1e-7, k_tangential=K, friction=MU)
     ci = NodalContactInterface(V, scene.facet_tags, *scene.contact_pair, law=law, bcs=bcs,
                                quadrature_degree=2 * order, pairing=pairing, basis=basis,
