@@ -274,8 +274,8 @@ def build(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2, load_h
 
     ``punch_scene`` reuses a :class:`PunchScene` of :func:`quarter_punch` (mesh sizes, order,
     cell type and edge grading are then taken from it); ``total_force`` is the full punch's
-    force at load factor 1 [N] (the quarter carries a quarter); ``solver_defaults`` are extra SNES/KSP/PC
-    defaults (without prefix) that the command line can override; ``solver_options`` are
+    force at load factor 1 [N] (the quarter carries a quarter); ``solver_defaults`` are extra
+    SNES/KSP/PC defaults (without prefix) that the command line can override; ``solver_options`` are
     extra keyword arguments of :class:`~rough_contact.solver.snes.SNESSolver` (e.g.
     ``linear_solver="hypre"``); ``dof_threshold=None`` is the solver's measured default.
 
