@@ -15,13 +15,16 @@ relative to the largest traction (about 1 for a penalty, the tolerance for exact
         [--quadrature gauss vertex nodal] [--reversal-stiffness 0 1] [--augmented 0 1 2 3]
         [--al-tol 1e-3] [--basis standard dual] [--residual-ratio 1e-2] [--ssn-r R]
         [--continuation none 100,10] [--after 10] [--linear-solver auto mumps hypre] [--csv FILE]
-        [--mesh-size H] [--contact-size HC]
+        [--mesh-size H] [--contact-size HC] [--edge-size HE] [--edge-band B]
 
 Levels (P1; mesh and contact size in LEVELS): 1 ~4.5 k DOFs, 2 ~26 k, 3 ~73 k, 4 ~99 k (the size
 of GetFEM's finest run). ``--mesh-size`` (bulk element size, (0, 50] mm) and ``--contact-size``
 (element size on the contact patch, (0, min(mesh size, 10)] mm) replace the level's sizes, for
 refining the bulk and the contact separately (docs/punch_refinement.md); every row shows the
-sizes used, the DOFs and the vertices of the punch's contact face.
+sizes used, the DOFs and the vertices of the punch's contact face. ``--edge-size`` (element
+size at the punch's free edge, (0, contact size] mm) and ``--edge-band`` (the distance from
+the edge within which it applies, (0, 10] mm, default the contact size) grade the mesh towards
+the edge (``rough_contact.scenes.meshes.flat_punch``).
 Units: mm, N, MPa.
 """
 
@@ -76,6 +79,23 @@ def level_sizes(level: int, mesh_size=None, contact_size=None) -> tuple:
     return h, hc
 
 
+def edge_sizes(contact_size: float, edge_size=None, edge_band=None) -> tuple:
+    """(edge size, edge band) [mm] of the edge grading (None, None: none); the band defaults
+    to the contact size. Raises ValueError naming the option, its value and the valid range."""
+    if edge_size is None:
+        if edge_band is not None:
+            raise ValueError(f"--edge-band = {edge_band!r} mm is invalid without --edge-size")
+        return None, None
+    if not (math.isfinite(edge_size) and 0.0 < edge_size <= contact_size):
+        raise ValueError(f"--edge-size = {edge_size!r} mm is invalid: valid range (0, "
+                         f"{contact_size:g}] mm (at most the contact size)")
+    edge_band = contact_size if edge_band is None else edge_band
+    if not (math.isfinite(edge_band) and 0.0 < edge_band <= PUNCH_HALF_WIDTH):
+        raise ValueError(f"--edge-band = {edge_band!r} mm is invalid: valid range (0, "
+                         f"{PUNCH_HALF_WIDTH:g}] mm (the punch's half width)")
+    return edge_size, edge_band
+
+
 def contact_vertices(scene, comm) -> int:
     """Global number of vertices of the punch's contact face (the first contact surface)."""
     xyz = facet_vertex_coordinates(scene, scene.contact_pair[0]).reshape(-1, 3)
@@ -86,8 +106,10 @@ def contact_vertices(scene, comm) -> int:
 def run(level: int, mu: float, k: float, width: float, predictor: str, quadrature="gauss",
         comm=MPI.COMM_WORLD, verbose=False, reversal_stiffness=1.0, augmented=False,
         al_tol=1e-3, continuation=None, linear_solver="auto", residual_ratio=1e-2,
-        basis="standard", mesh_size=None, contact_size=None, ssn_r=None) -> dict:
+        basis="standard", mesh_size=None, contact_size=None, edge_size=None,
+        edge_band=None, ssn_r=None) -> dict:
     mesh_size, contact_size = level_sizes(level, mesh_size, contact_size)
+    edge_size, edge_band = edge_sizes(contact_size, edge_size, edge_band)
     law = SoftplusPenalty(k_normal=k, width=width, k_tangential=k, friction=mu,
                           reversal_stiffness=reversal_stiffness)
     if augmented == 3:     # Alart-Curnier's semismooth Newton, tractions condensed (dual P1)
@@ -102,7 +124,8 @@ def run(level: int, mu: float, k: float, width: float, predictor: str, quadratur
                          load_half_width=10.0, law=law, steps=N_LOAD,
                          quadrature="gauss" if quadrature == "nodal" else quadrature,
                          points="nodal" if quadrature == "nodal" else "quadrature",
-                         basis=basis, enforcement=enforcement,
+                         basis=basis, enforcement=enforcement, edge_size=edge_size,
+                         edge_band=edge_band,
                          solver_options=dict(continuation=continuation,
                                              linear_solver=linear_solver))
     factors = load_unload_factors(N_LOAD, N_LOAD - 1, final_factor=1.0 / N_LOAD)
@@ -142,7 +165,9 @@ def run(level: int, mu: float, k: float, width: float, predictor: str, quadratur
                D_end=float("nan") if failed else incs[-1].dissipation,
                slip_peak=peak.n_slipping / max(peak.n_points, 1) if peak else float("nan"),
                gap_peak=exact[0], stick_peak=exact[1],
-               failed=failed)
+               failed=failed,
+               edge_size=float("nan") if edge_size is None else edge_size,
+               edge_band=float("nan") if edge_band is None else edge_band)
     m.solver.destroy()
     return out
 
@@ -207,6 +232,12 @@ def main(argv=None):
     ap.add_argument("--contact-size", type=float, default=None,
                     help="element size on the contact patch [mm], replacing the level's; "
                     "(0, min(mesh size, 10)]")
+    ap.add_argument("--edge-size", type=float, default=None,
+                    help="element size at the punch's free edge [mm] (edge grading; default "
+                    "none); (0, contact size]")
+    ap.add_argument("--edge-band", type=float, default=None,
+                    help="distance from the edge within which --edge-size applies [mm]; "
+                    "(0, 10], default the contact size")
     ap.add_argument("--csv", default=None)
     ap.add_argument("--verbose", action="store_true")
     args, _petsc = ap.parse_known_args(argv)   # the rest goes to PETSc
@@ -215,11 +246,12 @@ def main(argv=None):
                  f"give one level, not --levels {' '.join(map(str, args.levels))}")
     for level in args.levels:     # refused before any mesh is built
         try:
-            level_sizes(level, args.mesh_size, args.contact_size)
+            edge_sizes(level_sizes(level, args.mesh_size, args.contact_size)[1],
+                       args.edge_size, args.edge_band)
         except ValueError as exc:
             ap.error(str(exc))
     rows = []
-    head = (f"{'level':>5} {'h':>5} {'h_c':>5} {'DOFs':>7} {'verts':>6} {'points':>6} "
+    head = (f"{'level':>5} {'h':>5} {'h_c':>5} {'h_e/band':>10} {'DOFs':>7} {'verts':>6} {'points':>6} "
             f"{'mu':>4} {'k':>7} {'rev':>4} "
             f"{'predictor':>9} {'AL':>2} {'upd':>4} {'Nupd':>5} {'cont':>10} {'linear':>6} "
             f"{'Newton':>6} {'solves':>6} {'cutb':>4} {'max/inc':>7} {'CPU s':>7} "
@@ -246,11 +278,15 @@ def main(argv=None):
                             continuation=cont, linear_solver=ls,
                             residual_ratio=args.residual_ratio, basis=basis,
                             mesh_size=args.mesh_size, contact_size=args.contact_size,
+                            edge_size=args.edge_size, edge_band=args.edge_band,
                             ssn_r=args.ssn_r)
                     rows.append(r)
                     label = pred + "/" + quad[0] + ("*" if basis == "dual" else "")
                     PETSc.Sys.Print(
                         f"{r['level']:5d} {r['mesh_size']:5.3g} {r['contact_size']:5.3g} "
+                        + ("         -" if args.edge_size is None else
+                           f"{r['edge_size']:5.3g}/{r['edge_band']:4.3g}")
+                        + " "
                         f"{r['dofs']:7d} {r['vertices']:6d} {r['points']:6d} {mu:4.2f} {k:7.1e} "
                         f"{rs:4.2g} {label:>9} {al:2d} {r['al_updates']:4d} "
                         f"{r['newton_updates']:5d} "

@@ -197,12 +197,17 @@ class PunchScene:
 
 
 def quarter_punch(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2,
-                  load_half_width=2.5, cell_type="tetrahedron") -> PunchScene:
-    """Mesh the quarter punch and set its space and boundary conditions. Collective."""
+                  load_half_width=2.5, cell_type="tetrahedron", *, edge_size=None,
+                  edge_band=None) -> PunchScene:
+    """Mesh the quarter punch and set its space and boundary conditions. Collective.
+
+    ``edge_size``, ``edge_band``: grading towards the punch's free edge
+    (:func:`rough_contact.scenes.meshes.flat_punch.flat_punch`; None: none)."""
     check_mesh_arguments(order, mesh_size=mesh_size, contact_size=contact_size,
                          load_half_width=load_half_width)
     scene = flat_punch(mesh_size=mesh_size, contact_size=contact_size, order=order,
-                       load_half_width=load_half_width, cell_type=cell_type, comm=comm)
+                       load_half_width=load_half_width, cell_type=cell_type, comm=comm,
+                       edge_size=edge_size, edge_band=edge_band)
     V = vector_space(scene.mesh, order)
     ft = scene.facet_tags
     bcs = [fix(V, ft, scene.tag("symmetry_x"), 0), fix(V, ft, scene.tag("symmetry_y"), 1),
@@ -240,7 +245,8 @@ def build(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2, load_h
           dof_threshold=None, quadrature_degree=None, normal=None, seating_steps=None,
           cell_type="tetrahedron", *, punch_scene=None, total_force=TOTAL_FORCE,
           solver_defaults=None, quadrature="gauss", solver_options=None, enforcement=None,
-          kt_over_kn=None, pairing="auto", points="quadrature", basis="standard"):
+          kt_over_kn=None, pairing="auto", points="quadrature", basis="standard",
+          edge_size=None, edge_band=None):
     """Mesh, law, interface, problem and solver of the quarter punch. Collective.
 
     ``pairing`` pairs the punch bottom with the foundation (``ContactInterface(pairing=)``):
@@ -263,10 +269,13 @@ def build(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2, load_h
     basis: a vertex's jump uses its own DOFs, node to node on a conforming pairing;
     ``NodalContactInterface(basis=)``, docs/exact_contact_newton.md).
 
-    ``punch_scene`` reuses a :class:`PunchScene` of :func:`quarter_punch` (mesh sizes, order
-    and cell type are then taken from it); ``total_force`` is the full punch's force at load
-    factor 1 [N] (the quarter carries a quarter); ``solver_defaults`` are extra SNES/KSP/PC
-    defaults (without prefix) that the command line can override; ``solver_options`` are
+    ``edge_size``, ``edge_band`` grade the mesh towards the punch's free edge (passed to
+    :func:`quarter_punch`; None: no edge grading).
+
+    ``punch_scene`` reuses a :class:`PunchScene` of :func:`quarter_punch` (mesh sizes, order,
+    cell type and edge grading are then taken from it); ``total_force`` is the full punch's
+    force at load factor 1 [N] (the quarter carries a quarter); ``solver_defaults`` are extra
+    SNES/KSP/PC defaults (without prefix) that the command line can override; ``solver_options`` are
     extra keyword arguments of :class:`~rough_contact.solver.snes.SNESSolver` (e.g.
     ``linear_solver="hypre"``); ``dof_threshold=None`` is the solver's measured default.
 
@@ -290,7 +299,7 @@ def build(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2, load_h
     check_points_basis(points, basis)
     if punch_scene is None:
         punch_scene = quarter_punch(comm, mesh_size, contact_size, order, load_half_width,
-                                    cell_type)
+                                    cell_type, edge_size=edge_size, edge_band=edge_band)
     scene, V, bcs = punch_scene.scene, punch_scene.V, punch_scene.bcs
     order = element_degree(V)
 

@@ -11,6 +11,9 @@ same surface mesh as the punch bottom; the punch's interface nodes are then dupl
 (``rough_contact.fem.mesh``). The mesh is refined towards the contact patch with a gmsh
 Threshold field on the exact distance to the patch (a MathEval field: the distance to the
 rectangle [0, a]^2 x {0} is written in closed form, which is exact and needs no sampling).
+With ``edge_size`` (tetrahedra only) a second such field grades the mesh towards the punch's
+free edge, the segments x = a, 0 <= y <= a and y = a, 0 <= x <= a at z = 0, where the contact
+tractions are singular (docs/punch_refinement.md); the smaller of the two sizes wins.
 
 Labels (tags in brackets):
     bodies: "punch" (1), "foundation" (2)
@@ -42,10 +45,34 @@ from rough_contact.fem.mesh import (Scene, add_groups, build_contact_scene, enti
 __all__ = ["flat_punch"]
 
 
-def _refinement_field(model, a, contact_size, mesh_size, transition):
-    """Threshold on the exact distance to the patch [0, a]^2 x {0}: contact_size -> mesh_size."""
+def _refinement_field(model, a, contact_size, mesh_size, transition, extra=()):
+    """Threshold on the exact distance to the patch [0, a]^2 x {0}: contact_size -> mesh_size
+    (``extra``: further thresholds of ``refine_towards``, the smallest size winning)."""
     dx, dy = f"(Abs(x-{a})+x-{a})/2", f"(Abs(y-{a})+y-{a})/2"
-    refine_towards(model, f"Sqrt(({dx})^2+({dy})^2+z^2)", contact_size, mesh_size, transition)
+    refine_towards(model, f"Sqrt(({dx})^2+({dy})^2+z^2)", contact_size, mesh_size, transition,
+                   extra=extra)
+
+
+def _edge_distance(a):
+    """MathEval expression of the exact distance to the punch edge: the segments x = a,
+    0 <= y <= a and y = a, 0 <= x <= a at z = 0 (the quarter model has x, y >= 0)."""
+    d1 = f"Sqrt((x-{a})^2+((Abs(y-{a})+y-{a})/2)^2+z^2)"   # to x = a, 0 <= y <= a
+    d2 = f"Sqrt((y-{a})^2+((Abs(x-{a})+x-{a})/2)^2+z^2)"   # to y = a, 0 <= x <= a
+    return f"(({d1})+({d2})-Abs(({d1})-({d2})))/2"          # min(d1, d2)
+
+
+def _edge_field(a, edge_size, edge_band, contact_size, mesh_size, transition):
+    """``(distance, size, transition)`` of the edge grading for ``refine_towards(extra=)``:
+    ``edge_size`` within ``edge_band`` of the edge, then growing linearly at twice the patch
+    field's rate, (mesh_size - contact_size) / transition per mm, so that it falls below
+    the patch field only near the edge (for mesh_size = contact_size, where that rate is 0,
+    the size reaches contact_size at 2 edge_band). The distance is max(d - edge_band, 0)."""
+    rate = 2.0 * (mesh_size - contact_size) / transition
+    if rate <= 0.0:
+        rate = (contact_size - edge_size) / edge_band if contact_size > edge_size else 1.0
+    d = _edge_distance(a)
+    beyond = f"(Abs(({d})-{edge_band})+({d})-{edge_band})/2"
+    return beyond, edge_size, (mesh_size - edge_size) / rate
 
 
 def flat_punch(mesh_size: float = 10.0, contact_size: typing.Optional[float] = None,
@@ -53,7 +80,8 @@ def flat_punch(mesh_size: float = 10.0, contact_size: typing.Optional[float] = N
                foundation_half_width: float = 50.0, foundation_height: float = 50.0,
                load_half_width: typing.Optional[float] = None,
                transition: typing.Optional[float] = None, cell_type: str = "tetrahedron",
-               comm: MPI.Comm = MPI.COMM_WORLD) -> Scene:
+               comm: MPI.Comm = MPI.COMM_WORLD, edge_size: typing.Optional[float] = None,
+               edge_band: typing.Optional[float] = None) -> Scene:
     """Quarter model of the flat punch on the foundation (paper section 9.2). Collective.
 
     Args:
@@ -74,6 +102,13 @@ def flat_punch(mesh_size: float = 10.0, contact_size: typing.Optional[float] = N
             columns, geometric grading from ``contact_size`` to ``mesh_size`` away
             from the patch); order 2 gives 27-node hexahedra.
         comm: communicator of the mesh (gmsh runs on rank 0).
+        edge_size: element size at the punch's free edge [mm], 0 < edge_size <=
+            contact_size (tetrahedra only); ``None`` (default) adds no edge grading and
+            leaves the mesh as without the option.
+        edge_band: distance from the edge within which the size is ``edge_size`` [mm],
+            0 < edge_band <= half_width; beyond it the size grows linearly at twice the
+            patch field's rate until the patch field is the smaller. Default
+            ``contact_size``; only with ``edge_size``.
 
     Returns:
         The scene; ``contact_pair = (contact_punch, contact_foundation)``.
@@ -95,6 +130,22 @@ def flat_punch(mesh_size: float = 10.0, contact_size: typing.Optional[float] = N
     if load_half_width is not None and not 0 < load_half_width <= a:
         raise ValueError(f"load_half_width = {load_half_width} is invalid; valid range: "
                          f"(0, half_width = {a}] or None")
+    if edge_size is None:
+        if edge_band is not None:
+            raise ValueError(f"edge_band = {edge_band!r} is invalid without edge_size; valid: "
+                             "None, or give edge_size too")
+    else:
+        if cell_type != "tetrahedron":
+            raise ValueError(f"edge_size = {edge_size!r} is invalid with cell_type = "
+                             f"{cell_type!r}; edge grading is for tetrahedra only (edge_size "
+                             "= None for hexahedra)")
+        if not (np.isfinite(edge_size) and 0 < edge_size <= contact_size):
+            raise ValueError(f"edge_size = {edge_size!r} is invalid; valid range: "
+                             f"(0, contact_size = {contact_size}] mm")
+        edge_band = contact_size if edge_band is None else edge_band
+        if not (np.isfinite(edge_band) and 0 < edge_band <= a):
+            raise ValueError(f"edge_band = {edge_band!r} is invalid; valid range: "
+                             f"(0, half_width = {a}] mm")
     b = a if load_half_width is None else load_half_width
     tol = 1e-6 * max(L, H)
 
@@ -148,11 +199,15 @@ def flat_punch(mesh_size: float = 10.0, contact_size: typing.Optional[float] = N
 
             set_transfinite_hexahedra(model, contact_size, mesh_size, distance)
         else:
-            _refinement_field(model, a, contact_size, mesh_size, transition)
+            extra = (() if edge_size is None else
+                     [_edge_field(a, edge_size, edge_band, contact_size, mesh_size, transition)])
+            _refinement_field(model, a, contact_size, mesh_size, transition, extra)
         generate(model, order)
 
     return build_contact_scene(
         comm, "flat_punch", build, ("punch", "foundation"), ("contact_punch", "contact_foundation"),
         dimensions=dict(half_width=a, punch_height=hp, foundation_half_width=L,
                         foundation_height=H, load_half_width=b, mesh_size=mesh_size,
-                        contact_size=contact_size, transition=transition))
+                        contact_size=contact_size, transition=transition,
+                        **({} if edge_size is None else
+                           dict(edge_size=edge_size, edge_band=edge_band))))
