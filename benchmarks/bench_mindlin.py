@@ -1,7 +1,8 @@
 """Cattaneo–Mindlin and Mindlin–Deresiewicz under mesh refinement (rough_contact.scenes.mindlin).
 
     OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bench_mindlin.py [--levels 0.05 0.025]
-        [--part stick|energy|all] [--amplitudes 0.5] [--ring 0.25 [--ring-band 0.8 1.05]]
+        [--part stick|energy|all] [--amplitudes 0.5]
+        [--ring 0.25 [--ring-band 0.8 1.05] [--ring-growth 0.1]]
         [--exact --points nodal --basis dual] [--steps-per-cycle 16]
         [--half-width 4 --height 4 --mesh-size 1 --transition 1]
 
@@ -86,9 +87,10 @@ def masing_error(r, G, block_compliance):
 
 
 def energy(levels, amplitudes, kt=None, kt_scale=None, ring_size=None, ring_band=(0.8, 1.05),
-           width_ratio=1e-3, augmented=False, quadrature_degree=None, verbose=False,
-           steps_per_cycle=16, scene=None):
-    """``scene``: further arguments of ``mindlin.run`` (block, mesh, points, enforcement)."""
+           ring_growth=None, width_ratio=1e-3, augmented=False, quadrature_degree=None,
+           verbose=False, steps_per_cycle=16, scene=None):
+    """``scene``: further arguments of ``mindlin.run`` (block, mesh, points, enforcement).
+    ``ring_growth``: the ring's growth to the contact size, a fraction of Hertz's radius."""
     scene = dict(scene or {})
     PETSc.Sys.Print(f"{'h':>6} {'DOFs':>7} {'ampl':>5} {'Q*/muP':>6} {'W FE':>10} {'loop':>10} "
                     f"{'W MD':>10} {'error':>7} {'Masing':>7} {'Newton':>6} {'time s':>6} "
@@ -104,6 +106,8 @@ def energy(levels, amplitudes, kt=None, kt_scale=None, ring_size=None, ring_band
                             shear_steps=steps_per_cycle, k_tangential=_kt(h, kt, kt_scale),
                             ring_size=None if ring_size is None else h * ring_size,
                             ring_band=tuple(ring_band), width_ratio=width_ratio,
+                            ring_growth=None if ring_growth is None
+                            else ring_growth * np.sqrt(R * DELTA),
                             augmented=augmented, quadrature_degree=quadrature_degree,
                             verbose=verbose, **scene)
             t, s, Q, D = r.t, r.slide, r.Q, r.dissipation
@@ -134,6 +138,10 @@ def main(argv=None):
                     "level's contact size (e.g. 0.25: four times finer at the contact edge)")
     ap.add_argument("--ring-band", type=float, nargs=2, default=[0.8, 1.05],
                     help="the ring's radii as fractions of Hertz's radius sqrt(R delta)")
+    ap.add_argument("--ring-growth", type=float, default=None,
+                    help="energy: distance from the ring's band over which its size grows to the "
+                    "contact size, a fraction of Hertz's radius (default: towards --mesh-size "
+                    "over the band's width, too steep for a coarse far mesh)")
     ap.add_argument("--width-ratio", type=float, default=1e-3,
                     help="energy: softplus smoothing length / indentation (default 1e-3)")
     ap.add_argument("--augmented", action="store_true",
@@ -167,8 +175,8 @@ def main(argv=None):
         if args.exact:
             scene["enforcement"] = NewtonAugmentedLagrangian(args.al_tol, 60)
         energy(args.levels, args.amplitudes, args.k_tangential, args.kt_scale, args.ring,
-               args.ring_band, args.width_ratio, args.augmented, args.quadrature_degree,
-               args.verbose, args.steps_per_cycle, scene)
+               args.ring_band, args.ring_growth, args.width_ratio, args.augmented,
+               args.quadrature_degree, args.verbose, args.steps_per_cycle, scene)
 
 
 if __name__ == "__main__":
