@@ -12,8 +12,10 @@ a ~ 0.20 mm), then slid along x. "stick": the FE stick ratio sqrt(1 - A_slip / A
 (1 - Q / mu P)^(1/3) at every increment of a monotonic slide to gross slip (12 increments).
 "energy": two triangle cycles of the slide (16 increments each) at amplitude x (the slide that
 reaches mu P): the interface dissipation of the second cycle and the loop area of Q against the
-bottom slide (trapezoids) against Mindlin–Deresiewicz at the measured amplitude Q*, and the
-second cycle's descending branch against Masing's (largest |Q - Q_Masing| / Q*).
+bottom slide (trapezoids) against Mindlin–Deresiewicz at the measured amplitude Q* ("error",
+"loop e"; "trap": the trapezoids' own error on Masing's closed-form loop sampled at the same
+steps, -6.3 % at 8 steps per cycle, -1.6 % at 16), and the second cycle's descending branch
+against Masing's (largest |Q - Q_Masing| / Q*).
 Units: mm, N, MPa.
 """
 
@@ -86,6 +88,34 @@ def masing_error(r, G, block_compliance):
     return float(np.max(np.abs(r.Q[idx] - Q_ref)) / abs(Q_top)) if idx.size else float("nan")
 
 
+def sampled_loop_bias(slide, steps, block_compliance):
+    """The loop-area measure's own error at ``steps`` increments per cycle: trapezoids over
+    Masing's closed-form loop (Mindlin's virgin curve plus the block's compliance) sampled at
+    the bench's uniform slide steps, against Mindlin–Deresiewicz's energy at the same Q*
+    (tends to 0 as ``steps`` grows: 1024 steps give < 1e-4)."""
+    G = E / (2 * (1 + NU))
+    Es = E / (1 - NU**2)
+    P = references.hertz_force(DELTA, R, Es)
+    a = references.hertz_radius(P, R, Es)
+
+    def virgin(x):
+        lo, hi = np.zeros_like(x), np.full_like(x, MU * P)
+        for _ in range(80):
+            m = 0.5 * (lo + hi)
+            f = references.tangential_approach(m, MU, P, a, G, NU) + block_compliance * m
+            lo, hi = np.where(f < x, m, lo), np.where(f < x, hi, m)
+        return 0.5 * (lo + hi)
+
+    Qs = float(virgin(np.array([slide]))[0])
+    down = np.linspace(slide, -slide, steps // 2 + 1)
+    up = np.linspace(-slide, slide, steps // 2 + 1)
+    s = np.concatenate([down, up[1:]])
+    Q = np.concatenate([Qs - 2 * virgin(0.5 * (slide - down)),
+                        -Qs + 2 * virgin(0.5 * (up[1:] + slide))])
+    loop = float(np.sum(0.5 * (Q[1:] + Q[:-1]) * np.diff(s)))
+    return loop / float(references.energy_per_cycle(Qs, MU, P, a, G, NU)) - 1.0
+
+
 def energy(levels, amplitudes, kt=None, kt_scale=None, ring_size=None, ring_band=(0.8, 1.05),
            ring_growth=None, width_ratio=1e-3, augmented=False, quadrature_degree=None,
            verbose=False, steps_per_cycle=16, scene=None):
@@ -93,7 +123,8 @@ def energy(levels, amplitudes, kt=None, kt_scale=None, ring_size=None, ring_band
     ``ring_growth``: the ring's growth to the contact size, a fraction of Hertz's radius."""
     scene = dict(scene or {})
     PETSc.Sys.Print(f"{'h':>6} {'DOFs':>7} {'ampl':>5} {'Q*/muP':>6} {'W FE':>10} {'loop':>10} "
-                    f"{'W MD':>10} {'error':>7} {'Masing':>7} {'Newton':>6} {'time s':>6} "
+                    f"{'W MD':>10} {'error':>7} {'loop e':>7} {'trap':>7} {'Masing':>7} "
+                    f"{'Newton':>6} {'time s':>6} "
                     f"{'CPU s':>6}")
     G = E / (2 * (1 + NU))
     L, H = scene.get("half_width", 4.0), scene.get("height", 4.0)
@@ -117,8 +148,11 @@ def energy(levels, amplitudes, kt=None, kt_scale=None, ring_size=None, ring_band
             Qs = 0.5 * (Q[idx].max() - Q[idx].min())
             loop = float(np.sum(0.5 * (Q[idx][1:] + Q[idx][:-1]) * np.diff(s[idx])))
             ref = float(references.energy_per_cycle(Qs, MU, r.P[-1], r.a, G, NU))
+            trap = sampled_loop_bias(amp * gross_slide(L, H), steps_per_cycle, c_b)
             PETSc.Sys.Print(f"{h:6.4f} {r.dofs:7d} {amp:5.2f} {Qs / (MU * r.P[-1]):6.3f} "
                             f"{W:10.4e} {loop:10.4e} {ref:10.4e} {W / ref - 1:+7.3f} "
+                            f"{loop / ref - 1:+7.3f} "
+                            f"{trap:+7.4f} "
                             f"{masing_error(r, G, c_b):7.4f} {int(r.newton.sum()):6d} "
                             f"{time.perf_counter() - t0:6.0f} {time.process_time() - c0:6.0f}")
 
