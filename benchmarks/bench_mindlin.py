@@ -1,7 +1,7 @@
 """Cattaneo–Mindlin and Mindlin–Deresiewicz under mesh refinement (rough_contact.scenes.mindlin).
 
     OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bench_mindlin.py [--levels 0.05 0.025]
-        [--part stick|energy|all] [--amplitudes 0.5]
+        [--part stick|energy|all|mesh] [--amplitudes 0.5]
         [--ring 0.25 [--ring-band 0.8 1.05] [--ring-growth 0.1]]
         [--exact --points nodal --basis dual] [--steps-per-cycle 16]
         [--half-width 4 --height 4 --mesh-size 1 --transition 1]
@@ -116,6 +116,50 @@ def sampled_loop_bias(slide, steps, block_compliance):
     return loop / float(references.energy_per_cycle(Qs, MU, P, a, G, NU)) - 1.0
 
 
+def mesh_only(levels, ring_size=None, ring_band=(0.8, 1.05), ring_growth=None, scene=None):
+    """The scene's mesh alone (seconds, no solve): DOFs and, with a ring, the top-surface
+    vertices in the band against the count its area needs at the ring size (coverage ~1 when
+    gmsh has refined the whole band), and the vertex spacing there (median nearest neighbour).
+    For sizing runs before paying for them."""
+    import dolfinx
+    from scipy.spatial import cKDTree
+
+    from rough_contact.fem.compat import vector_space
+    from rough_contact.scenes.meshes.blocks import indented_block
+
+    scene = dict(scene or {})
+    a_h = np.sqrt(R * DELTA)
+    lo, hi = ring_band
+    PETSc.Sys.Print(f"{'h':>6} {'ring':>7} {'DOFs':>8} {'band verts':>10} {'coverage':>8} "
+                    f"{'spacing':>8}")
+    for h in levels:
+        size = None if ring_size is None else h * ring_size
+        ring = None if size is None else (0.5 * (lo + hi) * a_h, 0.5 * (hi - lo) * a_h, size)
+        sc = indented_block(half_width=scene.get("half_width", 4.0),
+                            height=scene.get("height", 4.0),
+                            mesh_size=scene.get("mesh_size", 1.0), contact_size=h,
+                            transition=scene.get("transition", 1.0), order=2, half=True,
+                            ring=ring, ring_growth=None if ring_growth is None
+                            else ring_growth * a_h)
+        dofs = 3 * vector_space(sc.mesh, 2).dofmap.index_map.size_global
+        msh = sc.mesh
+        msh.topology.create_connectivity(2, 0)
+        top = dolfinx.mesh.compute_incident_entities(
+            msh, sc.facet_tags.find(sc.tag("contact")), 2, 0)
+        nloc = msh.topology.index_map(0).size_local
+        xv = dolfinx.mesh.compute_midpoints(msh, 0, np.unique(top[top < nloc]))[:, :2]
+        xv = np.concatenate(msh.comm.allgather(xv))
+        rho = np.hypot(xv[:, 0], xv[:, 1]) / a_h
+        band = (rho > lo) & (rho < min(hi, 1.0))
+        if size is None or not band.any():
+            PETSc.Sys.Print(f"{h:6.4f} {'-':>7} {dofs:8d}")
+            continue
+        need = 0.5 * np.pi * a_h**2 * (min(hi, 1.0)**2 - lo**2) / (0.866 * size**2)
+        d, _ = cKDTree(xv).query(xv[band], k=2)
+        PETSc.Sys.Print(f"{h:6.4f} {size:7.5f} {dofs:8d} {int(band.sum()):10d} "
+                        f"{band.sum() / need:8.2f} {np.median(d[:, 1]):8.5f}")
+
+
 def energy(levels, amplitudes, kt=None, kt_scale=None, ring_size=None, ring_band=(0.8, 1.05),
            ring_growth=None, width_ratio=1e-3, augmented=False, quadrature_degree=None,
            verbose=False, steps_per_cycle=16, scene=None):
@@ -160,7 +204,8 @@ def energy(levels, amplitudes, kt=None, kt_scale=None, ring_size=None, ring_band
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--levels", type=float, nargs="+", default=[0.05, 0.025])
-    ap.add_argument("--part", choices=["stick", "energy", "all"], default="all")
+    ap.add_argument("--part", choices=["stick", "energy", "all", "mesh"], default="all",
+                    help="mesh: the energy scene's mesh only (DOFs, ring coverage)")
     ap.add_argument("--amplitudes", type=float, nargs="+", default=[0.5])
     ap.add_argument("--k-tangential", type=float, default=None,
                     help="tangential penalty [MPa/mm] (default: the normal one, 1e8)")
@@ -200,6 +245,11 @@ def main(argv=None):
                     help="energy: print every increment (Newton iterations, multiplier updates, "
                     "cutbacks)")
     args = ap.parse_args(argv)
+    if args.part == "mesh":
+        mesh_only(args.levels, args.ring, args.ring_band, args.ring_growth,
+                  dict(half_width=args.half_width, height=args.height,
+                       mesh_size=args.mesh_size, transition=args.transition))
+        return
     if args.part in ("stick", "all"):
         stick(args.levels, args.k_tangential, args.kt_scale)
     if args.part in ("energy", "all"):
