@@ -196,7 +196,8 @@ def _gather_points(comm, x, arrays):
 def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5, nu=0.49,
         mu=0.3, penalty=INDENTER_PENALTY, half_width=4.0, height=4.0, mesh_size=1.0, preload_steps=2,
         shear_steps=12, cycles=0, indenter="paraboloid", quadrature_degree=None,
-        k_tangential=None, ring_size=None, ring_band=(0.8, 1.05), width_ratio=1e-3,
+        k_tangential=None, ring_size=None, ring_band=(0.8, 1.05), ring_growth=None,
+        width_ratio=1e-3,
         augmented=False, augmentation_tolerance=1e-3, points="quadrature", transition=1.0,
         refined_radius=0.4, gather_radius=1.5, front_band=0.5,
         max_updates=30, basis="standard", enforcement=None, comm=MPI.COMM_WORLD,
@@ -219,7 +220,10 @@ def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5
     ``ring_size``: element size [mm] in the annulus ``ring_band`` (fractions of Hertz's radius
     sqrt(R delta)) where the slip zone of a small tangential load lies (c/a = 0.95 at
     Q/mu P = 0.15, a ring 0.05 a wide); default: no ring, ``contact_size`` everywhere in the
-    contact. The tangential penalty keeps its ``contact_size`` scaling.
+    contact. The tangential penalty keeps its ``contact_size`` scaling. ``ring_growth``: the
+    distance [mm] from the band over which the ring's size grows to ``contact_size``
+    (``indented_block(ring_growth=)``; needed on a large block with a coarse far mesh);
+    default: towards ``mesh_size`` over the band's width.
 
     ``half_width``, ``height``, ``mesh_size``, ``transition``, ``refined_radius`` [mm]: the
     block and its mesh (``indented_block``): the element size grows from ``contact_size``
@@ -294,7 +298,7 @@ def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5
     scene = indented_block(half_width=half_width, height=height, mesh_size=mesh_size,
                            contact_size=contact_size, transition=transition,
                            refined_radius=refined_radius, order=order, half=True,
-                           ring=ring, comm=comm)
+                           ring=ring, ring_growth=ring_growth, comm=comm)
     V = vector_space(scene.mesh, order)
     sym = fix(V, scene.facet_tags, scene.tag("symmetry_y"), 1)
     if k_tangential is None:

@@ -376,3 +376,38 @@ def test_indented_block_ring_refines_the_band_only():
     assert mean(inner) > 0.7 * h
     with pytest.raises(ValueError, match="ring_size"):
         indented_block(ring=(0.5, 0.1, 0.0))
+
+
+def test_indented_block_ring_growth_refines_a_narrow_band_under_a_coarse_far_mesh():
+    """A narrow ring on a large block with a coarse far mesh (the Mindlin energy scene's: band
+    0.744-1.03 of a = 0.2 mm, 64 mm block, 16 mm far size): growing towards ``mesh_size`` over
+    the band's width, the size passes the contact size within 2e-4 mm of the band and gmsh
+    leaves the band under-refined (123 top facets in it, longest edges 3.1 x the ring size on
+    average); with
+    ``ring_growth`` (to the contact size over 2 half bands) the band's facets have the ring's
+    size and the centre keeps the contact size."""
+    from rough_contact.scenes.meshes.blocks import indented_block
+
+    h, ring = 0.05, (0.1774, 0.0286, 0.008)
+    scene = indented_block(half_width=64.0, height=64.0, mesh_size=16.0, contact_size=h,
+                           transition=48.0, refined_radius=0.4, half=True, ring=ring,
+                           ring_growth=2.0 * ring[1])
+    xyz = facet_vertex_coordinates(scene, scene.tag("contact"))
+    rho = np.linalg.norm(xyz.mean(axis=1)[:, :2], axis=1)
+    edge = np.linalg.norm(xyz - np.roll(xyz, 1, axis=1), axis=2).max(axis=1)
+
+    def mean(sel):
+        n = COMM.allreduce(int(sel.sum()), op=MPI.SUM)
+        return COMM.allreduce(float(edge[sel].sum()), op=MPI.SUM) / n, n
+
+    band, n_band = mean(np.abs(rho - ring[0]) < 0.8 * ring[1])
+    inner, n_inner = mean(rho < 0.05)
+    assert n_band > 300 and n_inner > 2
+    assert band < 1.3 * ring[2]
+    assert inner > 0.7 * h
+    with pytest.raises(ValueError, match="ring_growth"):
+        indented_block(ring=(0.5, 0.1, 0.05), ring_growth=0.0)
+    with pytest.raises(ValueError, match="ring size"):
+        indented_block(contact_size=0.05, ring=(0.5, 0.1, 0.06), ring_growth=0.1)
+    with pytest.raises(ValueError, match="without a ring"):
+        indented_block(ring_growth=0.1)
