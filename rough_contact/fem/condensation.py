@@ -156,7 +156,9 @@ class DualCondensation:
         self.n_glob = n_glob
         self._L = self._Kg = None
         # augmentation: given, or the bulk stiffness per area at the vertex's node
-        d = K.getDiagonal().array[self.S_local] if n_v else np.zeros((0, 3))
+        diag = K.getDiagonal()             # collective: also on a rank without contact vertices
+        d = diag.array[self.S_local] if n_v else np.zeros((0, 3))
+        diag.destroy()
         free = np.maximum((~fixed).sum(axis=1), 1)
         stiffness = np.where(fixed, 0.0, d).sum(axis=1) / free / self.m
         self.r_normal = stiffness if r_normal is None else np.full(n_v, float(r_normal))
