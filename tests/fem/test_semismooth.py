@@ -129,15 +129,17 @@ def test_condensed_jacobian_against_finite_differences():
     assert err <= 1e-6 * scale
 
 
-def _punch(enforcement, comm=MPI.COMM_WORLD):
+def _punch(enforcement, comm=MPI.COMM_WORLD, snes_rtol=None):
     """The coarse punch of tests/fem/test_nodal_ssn.py: dissipation per increment, vertex
-    tractions at the end, Newton iterations."""
+    tractions at the end, Newton iterations. ``snes_rtol`` overrides the solver's relative
+    tolerance (1e-9 by default, which leaves the answer uncertain at that level)."""
     from rough_contact.scenes import flat_punch
     law = SoftplusPenalty(k_normal=1e7, width=2.5e-9, k_tangential=1e7, friction=0.2)
     m = flat_punch.build(comm, mesh_size=20.0, contact_size=2.0, order=1,
                          load_half_width=10.0, law=law, steps=4, points="nodal", basis="dual",
                          enforcement=enforcement, prefix="test_semismooth_punch_",
-                         solver_options=dict(linear_solver="mumps"))
+                         solver_options=dict(linear_solver="mumps"),
+                         solver_defaults=None if snes_rtol is None else {"snes_rtol": snes_rtol})
     incs = list(load_path(m.problem, m.solver, load_unload_factors(4, 3, final_factor=0.25)))
     pf = m.interface.point_fields()
     x = np.concatenate(comm.allgather(m.interface.point_coordinates()))
@@ -162,9 +164,13 @@ def test_punch_same_answer_as_in_newton_multipliers(punch_ssn):
     assert newton < newton_a
 
 
-def test_punch_rank_independent(punch_ssn):
-    D, t, _, _ = punch_ssn
-    D_s, t_s, _, _ = _punch(SemismoothNewton(), MPI.COMM_SELF)
+def test_punch_rank_independent():
+    # The default relative tolerance (1e-9) stops Newton once the residual is 1e-9 of its
+    # start, so two partitions may stop at answers that differ at that level (measured: 6e-10
+    # relative on DOLFINx 0.9). Converging both to round-off (one more quadratic iteration)
+    # makes the comparison measure the partition, not the stopping test.
+    D, t, _, _ = _punch(SemismoothNewton(), snes_rtol=1e-13)
+    D_s, t_s, _, _ = _punch(SemismoothNewton(), MPI.COMM_SELF, snes_rtol=1e-13)
     np.testing.assert_allclose(D, D_s, rtol=1e-10, atol=1e-14)
     np.testing.assert_allclose(t, t_s, rtol=0, atol=1e-10 * np.abs(t_s).max())
 
