@@ -1,7 +1,8 @@
 """Shared FE test helper: a contact interface's force, residual and Jacobian figures at one
 state, and the Jacobian checked against central differences of the residual.
 
-Also the two blocks on rollers that the nodal and semismooth tests press together.
+Also the two blocks on rollers that the nodal and semismooth tests press together, and the
+central difference of a residual that the Jacobian checks use.
 
 Imported by tests/fem/test_nodal.py, test_nonmatching.py, test_nodal_ssn.py and
 test_semismooth.py (which put this folder on sys.path). Collective: every rank calls it.
@@ -66,23 +67,35 @@ def residual_jacobian_figures(ci, u, V, fd: bool = False):
         d.setArray(rng.uniform(-1, 1, 3 * V.dofmap.index_map.size_global)[r0:r1] * 1e-4)
         Jd = b.duplicate()
         A.mult(d, Jd)
-        eps = 1e-5
-        res = []
-        for sgn in (1.0, -1.0):
-            xs = x.copy()
-            xs.axpy(sgn * eps, d)
-            bs = b.duplicate()
+
+        def residual(xs, bs):
             bs.set(0.0)
             ci.evaluate(xs)
             ci.assemble_residual(bs)
-            res.append(bs)
-        fd_vec = res[0].copy()
-        fd_vec.axpy(-1.0, res[1])
-        fd_vec.scale(0.5 / eps)
+
+        fd_vec = central_difference(residual, x, d, 1e-5)
         fd_vec.axpy(-1.0, Jd)
         fd_err = fd_vec.norm() / Jd.norm()
     A.destroy()
     return figs, fd_err
+
+
+def central_difference(residual, x, d, eps, check=None):
+    """(R(x + eps d) - R(x - eps d)) / (2 eps) as a new PETSc vector; ``residual(xs, bs)``
+    writes R(xs) into ``bs``. ``check()``, if given, runs after each evaluation (e.g. to assert
+    that no branch of a non-smooth law changed within eps)."""
+    res = []
+    for sgn in (1.0, -1.0):
+        xs = x.copy()
+        xs.axpy(sgn * eps, d)
+        bs = x.duplicate()
+        residual(xs, bs)
+        if check is not None:
+            check()
+        res.append(bs)
+    res[0].axpy(-1.0, res[1])
+    res[0].scale(0.5 / eps)
+    return res[0]
 
 
 def interpolate_two_bodies(u, scene):

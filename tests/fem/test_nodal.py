@@ -22,7 +22,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 from mpi4py import MPI
-from petsc4py import PETSc
 
 from dolfinx import fem
 from rough_contact.fem import compat
@@ -30,34 +29,20 @@ from rough_contact.fem.nodal import NodalContactInterface
 from rough_contact.fem.problem import ContactProblem, Material, SurfaceLoad
 from rough_contact.interface.enforcement import AugmentedLagrangian, Penalty
 from rough_contact.interface.penalty import LinearPenalty, SoftplusPenalty
-from rough_contact.scenes.meshes.blocks import separate_blocks, two_blocks
 from rough_contact.solver.loading import load_path
 from rough_contact.solver.snes import SNESSolver
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))   # tests/: shared checks
-from interface_checks import interpolate_two_bodies, residual_jacobian_figures  # noqa: E402
+from interface_checks import (blocks_on_rollers, interpolate_two_bodies,  # noqa: E402
+                              residual_jacobian_figures)
 
 E, NU, PRESSURE = 2.0e5, 0.25, 80.0
-
-
-def _roller(V, scene, name, comp):
-    facets = scene.facet_tags.find(scene.tag(name))
-    dofs = fem.locate_dofs_topological(V.sub(comp), 2, facets)
-    return fem.dirichletbc(PETSc.ScalarType(0.0), dofs, V.sub(comp))
 
 
 def _patch(mesh, order, pairing, friction, cell_type="tetrahedron", comm=MPI.COMM_WORLD):
     """Uniform pressure on the top of two blocks on rollers; (largest pressure error / p,
     largest shear / p, contact force, slipping vertices, nominal area, interface)."""
-    if mesh == "conforming":
-        scene = two_blocks(h1=1.0, h2=0.5, mesh_size=0.3, order=order, cell_type=cell_type,
-                           comm=comm)
-    else:
-        scene = separate_blocks(h1=1.0, h2=0.5, size_lower=0.2, size_upper=0.28, order=order,
-                                cell_type=cell_type, comm=comm)
-    V = compat.vector_space(scene.mesh, order)
-    bcs = [_roller(V, scene, "x0", 0), _roller(V, scene, "y0", 1),
-           _roller(V, scene, "bottom", 2)]
+    scene, V, bcs = blocks_on_rollers(comm, mesh, order, cell_type)
     if friction:      # same material: no lateral slide, exact stick and contact
         law = SoftplusPenalty(1e6, 1e-7, k_tangential=1e6, friction=0.3)
         enforcement, E_lower = AugmentedLagrangian(tolerance=1e-9, max_updates=50), E
@@ -109,12 +94,7 @@ def test_patch_uniform_pressure_is_transmitted_exactly(case, friction):
 def _figures(comm, pairing, order, fd=False):
     """Force, residual and Jacobian norms, real and nominal area at a smooth non-uniform
     displacement with friction; optionally the finite-difference error of the Jacobian."""
-    if pairing == "conforming":
-        scene = two_blocks(h1=1.0, h2=0.5, mesh_size=0.3, order=order, comm=comm)
-    else:
-        scene = separate_blocks(h1=1.0, h2=0.5, size_lower=0.2, size_upper=0.28, order=order,
-                                comm=comm)
-    V = compat.vector_space(scene.mesh, order)
+    scene, V, _ = blocks_on_rollers(comm, pairing, order)
     law = SoftplusPenalty(1e4, 1e-3, k_tangential=5e3, friction=0.2)
     ci = NodalContactInterface(V, scene.facet_tags, *scene.contact_pair, law=law,
                                quadrature_degree=2 * order, pairing=pairing)
