@@ -51,6 +51,7 @@ from rough_contact.interface.enforcement import (AugmentedLagrangian, NewtonAugm
                                                  Penalty)
 from rough_contact.interface.penalty import SoftplusPenalty
 from rough_contact.scenes import flat_punch
+from rough_contact.scenes.meshes.flat_punch import edge_grading
 from rough_contact.solver.loading import LoadStepError, load_path, load_unload_factors
 from rough_contact.solver.snes import Continuation
 
@@ -80,20 +81,9 @@ def level_sizes(level: int, mesh_size=None, contact_size=None) -> tuple:
 
 
 def edge_sizes(contact_size: float, edge_size=None, edge_band=None) -> tuple:
-    """(edge size, edge band) [mm] of the edge grading (None, None: none); the band defaults
-    to the contact size. Raises ValueError naming the option, its value and the valid range."""
-    if edge_size is None:
-        if edge_band is not None:
-            raise ValueError(f"--edge-band = {edge_band!r} mm is invalid without --edge-size")
-        return None, None
-    if not (math.isfinite(edge_size) and 0.0 < edge_size <= contact_size):
-        raise ValueError(f"--edge-size = {edge_size!r} mm is invalid: valid range (0, "
-                         f"{contact_size:g}] mm (at most the contact size)")
-    edge_band = contact_size if edge_band is None else edge_band
-    if not (math.isfinite(edge_band) and 0.0 < edge_band <= PUNCH_HALF_WIDTH):
-        raise ValueError(f"--edge-band = {edge_band!r} mm is invalid: valid range (0, "
-                         f"{PUNCH_HALF_WIDTH:g}] mm (the punch's half width)")
-    return edge_size, edge_band
+    """(edge size, edge band) [mm] of the edge grading (None, None: none), checked by the mesh
+    builder's own rule before any mesh is built (the band defaults to the contact size)."""
+    return edge_grading(contact_size, PUNCH_HALF_WIDTH, edge_size, edge_band)
 
 
 def contact_vertices(scene, comm) -> int:

@@ -61,6 +61,32 @@ def _edge_distance(a):
     return f"(({d1})+({d2})-Abs(({d1})-({d2})))/2"          # min(d1, d2)
 
 
+def edge_grading(contact_size: float, half_width: float, edge_size=None, edge_band=None,
+                 cell_type: str = "tetrahedron") -> tuple:
+    """The checked (edge_size, edge_band) of the grading towards the punch's free edge [mm]:
+    (None, None) without ``edge_size``; the band defaults to ``contact_size``. Raises
+    ValueError naming the quantity, its value and the valid range (0 < edge_size <=
+    contact_size, 0 < edge_band <= half_width, tetrahedra only). The benchmarks call it to
+    refuse a bad option before any mesh is built."""
+    if edge_size is None:
+        if edge_band is not None:
+            raise ValueError(f"edge_band = {edge_band!r} is invalid without edge_size; valid: "
+                             "None, or give edge_size too")
+        return None, None
+    if cell_type != "tetrahedron":
+        raise ValueError(f"edge_size = {edge_size!r} is invalid with cell_type = "
+                         f"{cell_type!r}; edge grading is for tetrahedra only (edge_size "
+                         "= None for hexahedra)")
+    if not (np.isfinite(edge_size) and 0 < edge_size <= contact_size):
+        raise ValueError(f"edge_size = {edge_size!r} is invalid; valid range: "
+                         f"(0, contact_size = {contact_size}] mm")
+    edge_band = contact_size if edge_band is None else edge_band
+    if not (np.isfinite(edge_band) and 0 < edge_band <= half_width):
+        raise ValueError(f"edge_band = {edge_band!r} is invalid; valid range: "
+                         f"(0, half_width = {half_width}] mm")
+    return edge_size, edge_band
+
+
 def _edge_field(a, edge_size, edge_band, contact_size, mesh_size, transition):
     """``(distance, size, transition)`` of the edge grading for ``refine_towards(extra=)``:
     ``edge_size`` within ``edge_band`` of the edge, then growing linearly at twice the patch
@@ -130,22 +156,7 @@ def flat_punch(mesh_size: float = 10.0, contact_size: typing.Optional[float] = N
     if load_half_width is not None and not 0 < load_half_width <= a:
         raise ValueError(f"load_half_width = {load_half_width} is invalid; valid range: "
                          f"(0, half_width = {a}] or None")
-    if edge_size is None:
-        if edge_band is not None:
-            raise ValueError(f"edge_band = {edge_band!r} is invalid without edge_size; valid: "
-                             "None, or give edge_size too")
-    else:
-        if cell_type != "tetrahedron":
-            raise ValueError(f"edge_size = {edge_size!r} is invalid with cell_type = "
-                             f"{cell_type!r}; edge grading is for tetrahedra only (edge_size "
-                             "= None for hexahedra)")
-        if not (np.isfinite(edge_size) and 0 < edge_size <= contact_size):
-            raise ValueError(f"edge_size = {edge_size!r} is invalid; valid range: "
-                             f"(0, contact_size = {contact_size}] mm")
-        edge_band = contact_size if edge_band is None else edge_band
-        if not (np.isfinite(edge_band) and 0 < edge_band <= a):
-            raise ValueError(f"edge_band = {edge_band!r} is invalid; valid range: "
-                             f"(0, half_width = {a}] mm")
+    edge_size, edge_band = edge_grading(contact_size, a, edge_size, edge_band, cell_type)
     b = a if load_half_width is None else load_half_width
     tol = 1e-6 * max(L, H)
 
