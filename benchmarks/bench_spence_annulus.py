@@ -3,10 +3,12 @@ against beta/mu, its ring convergence, and the annulus of the Cattaneo–Mindlin
 
     OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bench_spence_annulus.py
         [--ratios 0.5 0.6 0.7 0.8 1 1.5 2 3] [--rings 200 400 800] [--nu 0.49] [--mu 0.3]
+        [--fit-max 1]
 
 Prints, per beta/mu and ring count, c/a at the end of the loading, its spread over the loading
 from a = 0.4 on (self-similarity), the CPU time; then a straight-line fit of ln(1 - c/a)
-against mu/beta over the finest rings' resolved rows (1 - c/a at least 3 ring widths) and its
+against mu/beta over the finest rings' resolved rows (1 - c/a at least 3 ring widths, beta/mu
+<= --fit-max: the thin-annulus regime) and its
 value at the scene's beta/mu (rigid sphere on an elastic block with --nu and --mu): the
 annulus width that the fit predicts, to be compared with the scene's element size.
 """
@@ -28,6 +30,8 @@ def main(argv=None):
     ap.add_argument("--rings", type=int, nargs="+", default=[200, 400, 800])
     ap.add_argument("--nu", type=float, default=0.49, help="the block's Poisson ratio")
     ap.add_argument("--mu", type=float, default=0.3, help="friction coefficient")
+    ap.add_argument("--fit-max", type=float, default=1.0,
+                    help="fit only the rows with beta/mu <= this (the thin-annulus regime)")
     args = ap.parse_args(argv)
     beta = abs(coupling_parameter(np.inf, 0.3, 2.0e5, args.nu))
     scene = beta / args.mu
@@ -45,7 +49,7 @@ def main(argv=None):
             print(f"{ratio:8.4f} {n:6d} {c:8.4f} {1 - c:9.2e} {np.ptp(late):8.4f} {cpu:7.1f}")
         finest[ratio] = (c, n)
     rows = [(1.0 / r, np.log(1.0 - c)) for r, (c, n) in finest.items()
-            if r != scene and 1.0 - c >= 3.0 / n]
+            if r != scene and r <= args.fit_max and 1.0 - c >= 3.0 / n]
     if len(rows) >= 2:
         x, y = np.array(rows).T
         slope, icpt = np.polyfit(x, y, 1)
