@@ -80,12 +80,6 @@ def level_sizes(level: int, mesh_size=None, contact_size=None) -> tuple:
     return h, hc
 
 
-def edge_sizes(contact_size: float, edge_size=None, edge_band=None) -> tuple:
-    """(edge size, edge band) [mm] of the edge grading (None, None: none), checked by the mesh
-    builder's own rule before any mesh is built (the band defaults to the contact size)."""
-    return edge_grading(contact_size, PUNCH_HALF_WIDTH, edge_size, edge_band)
-
-
 def contact_vertices(scene, comm) -> int:
     """Global number of vertices of the punch's contact face (the first contact surface)."""
     xyz = facet_vertex_coordinates(scene, scene.contact_pair[0]).reshape(-1, 3)
@@ -99,7 +93,7 @@ def run(level: int, mu: float, k: float, width: float, predictor: str, quadratur
         basis="standard", mesh_size=None, contact_size=None, edge_size=None,
         edge_band=None, ssn_r=None) -> dict:
     mesh_size, contact_size = level_sizes(level, mesh_size, contact_size)
-    edge_size, edge_band = edge_sizes(contact_size, edge_size, edge_band)
+    edge_size, edge_band = edge_grading(contact_size, PUNCH_HALF_WIDTH, edge_size, edge_band)
     law = SoftplusPenalty(k_normal=k, width=width, k_tangential=k, friction=mu,
                           reversal_stiffness=reversal_stiffness)
     if augmented == 3:     # Alart-Curnier's semismooth Newton, tractions condensed (dual P1)
@@ -236,8 +230,8 @@ def main(argv=None):
                  f"give one level, not --levels {' '.join(map(str, args.levels))}")
     for level in args.levels:     # refused before any mesh is built
         try:
-            edge_sizes(level_sizes(level, args.mesh_size, args.contact_size)[1],
-                       args.edge_size, args.edge_band)
+            edge_grading(level_sizes(level, args.mesh_size, args.contact_size)[1],
+                         PUNCH_HALF_WIDTH, args.edge_size, args.edge_band)
         except ValueError as exc:
             ap.error(str(exc))
     rows = []

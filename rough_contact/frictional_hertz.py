@@ -49,6 +49,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.special import ellipe, ellipk
 
+from rough_contact.references import hertz_pressure
 from rough_contact.validation import check_scalar
 
 __all__ = ["coupling_parameter", "ring_kernel", "ring_influence", "hertz_radial_term",
@@ -161,14 +162,12 @@ def slip_annulus(beta_over_mu: float, rings: int = 400, max_sweeps: int = 200) -
     r = 0.5 * (edges[1:] + edges[:-1])
     A = ring_influence(edges)
     u_prev = np.zeros(n)                   # (E*/2) u_r / mu
-    q = np.zeros(n)
-    p = np.zeros(n)
-    stick = np.zeros(n, dtype=bool)
     ratios, inner = np.ones(n), np.ones(n)
+    half = 0.5 / n
     for m in range(1, n + 1):
         a = edges[m]
         contact = r < a
-        p = np.where(contact, a * np.sqrt(np.clip(1.0 - (r / a) ** 2, 0.0, None)), 0.0)
+        p = hertz_pressure(r, a, a)          # p0 proportional to a (Hertz); 0 beyond a
         phi = beta_over_mu * hertz_radial_term(r, a, a)
         stick = contact.copy()
         sign = np.zeros(n)
@@ -192,7 +191,6 @@ def slip_annulus(beta_over_mu: float, rings: int = 400, max_sweeps: int = 200) -
             raise RuntimeError(f"slip_annulus: the stick/slip set of increment {m} (a = {a:g}) "
                                f"did not settle in max_sweeps = {max_sweeps} sweeps")
         u_prev = u
-        half = 0.5 / n
         st, sl = contact & stick, contact & ~stick
         if sl.any():
             ratios[m - 1] = (r[st].max() + half) / a if st.any() else 0.0
