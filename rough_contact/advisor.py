@@ -701,7 +701,6 @@ def advise(surface, material: AsperityMaterial, pressure_range, tolerance: float
         d_pl, f"psi = {psi:.3g} ({psi_text}); at the scene's pressures the elasto-plastic law "
               f"differs from the elastic one by {e_pl:.2%} in {q_pl} "
               f"({'<=' if elastic_ok else '>'} tolerance {tol:.3g}) up to {p_hi:.4g} MPa"))
-    family = "elastic" if elastic_ok else "elasto-plastic"
     full_normal = "elasto-plastic"
 
     # -- anisotropy ---------------------------------------------------------------------------

@@ -50,15 +50,10 @@ import numpy as np
 from scipy.special import ellipe, ellipk
 
 from rough_contact.references import hertz_pressure
-from rough_contact.validation import check_scalar
+from rough_contact.validation import check_integer, check_scalar
 
 __all__ = ["coupling_parameter", "ring_kernel", "ring_influence", "hertz_radial_term",
            "SlipAnnulus", "slip_annulus"]
-
-
-def _check_count(name: str, value, lo: int) -> None:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < lo:
-        raise ValueError(f"{name} = {value!r} is invalid: valid range integers >= {lo}")
 
 
 def coupling_parameter(E1: float, nu1: float, E2: float, nu2: float) -> float:
@@ -95,7 +90,7 @@ def ring_influence(edges: np.ndarray, gauss_points: int = 24) -> np.ndarray:
     if edges.ndim != 1 or edges.size < 2 or edges[0] < 0 or np.any(np.diff(edges) <= 0):
         raise ValueError(f"edges = {edges!r} is invalid: need an increasing 1-D array of at "
                          "least 2 radii >= 0")
-    _check_count("gauss_points", gauss_points, 2)
+    check_integer("gauss_points", gauss_points, lo=2)
     r = 0.5 * (edges[1:] + edges[:-1])
     u, w = np.polynomial.legendre.leggauss(int(gauss_points))
     u, w = 0.5 * (u + 1.0), 0.5 * w
@@ -155,8 +150,8 @@ def slip_annulus(beta_over_mu: float, rings: int = 400, max_sweeps: int = 200) -
     ValueError for a bad input and RuntimeError if an increment's active set does not settle
     within ``max_sweeps``."""
     check_scalar("beta_over_mu", beta_over_mu, lo=0.0, lo_open=False)
-    _check_count("rings", rings, 4)
-    _check_count("max_sweeps", max_sweeps, 1)
+    check_integer("rings", rings, lo=4)
+    check_integer("max_sweeps", max_sweeps, lo=1)
     n = int(rings)
     edges = np.linspace(0.0, 1.0, n + 1)
     r = 0.5 * (edges[1:] + edges[:-1])

@@ -53,7 +53,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rough_contact.validation import check_scalar
+from rough_contact.validation import check_integer, check_scalar
 
 __all__ = ["StickFront", "stick_front", "contact_front", "mindlin_tractions"]
 
@@ -149,9 +149,7 @@ def stick_front(r, pressure, shear, mu: float, weights, sticking, slipping, band
     slip = _array("slipping", slipping, n, dtype=bool)
     mu = check_scalar("mu", mu, lo=0.0)
     band = check_scalar("band", band, lo=0.0, hi=1.0, hi_open=False)
-    if int(max_iterations) != max_iterations or max_iterations < 1:
-        raise ValueError(f"max_iterations = {max_iterations!r} is invalid: it must be an "
-                         "integer >= 1")
+    check_integer("max_iterations", max_iterations, lo=1)
     bad = ~np.isfinite(r) | (r < 0.0)
     if bad.any():
         raise ValueError(f"r = {float(r[bad][0])!r} mm is invalid: radii must be finite and >= 0")

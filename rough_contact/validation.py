@@ -8,9 +8,10 @@ Pure module: numpy only.
 from __future__ import annotations
 
 import math
+import numbers
 from typing import Optional
 
-__all__ = ["check_scalar"]
+__all__ = ["check_scalar", "check_integer"]
 
 
 def check_scalar(name: str, value, *, lo: Optional[float] = None, hi: Optional[float] = None,
@@ -52,3 +53,24 @@ def check_scalar(name: str, value, *, lo: Optional[float] = None, hi: Optional[f
     rng = "finite" + (" and " + " and ".join(parts) if parts else "")
     shown = f"{value!r}" + (f" {unit}" if unit else "")
     raise ValueError(f"{name} = {shown} is invalid: it must be {rng}")
+
+
+def check_integer(name: str, value, *, lo: int, hi: Optional[int] = None, what: str = "") -> int:
+    """Return ``int(value)`` if it is an integer in ``[lo, hi]``, else raise ``ValueError``.
+
+    Python and numpy integers pass; ``True``/``False``, floats (even ``10.0``) and strings do
+    not: a count given as a float is usually a misplaced argument.
+
+    Args:
+        name: the quantity as the user knows it (e.g. ``"max_updates"``).
+        value: the number given.
+        lo: the smallest valid value.
+        hi: the largest valid value (None = unbounded).
+        what: what the count counts, shown in parentheses (e.g. ``"Newton iterations"``).
+    """
+    if (isinstance(value, numbers.Integral) and not isinstance(value, bool) and value >= lo
+            and (hi is None or value <= hi)):
+        return int(value)
+    rng = f">= {lo}" if hi is None else f"in [{lo}, {hi}]"
+    raise ValueError(f"{name} = {value!r} is invalid: it must be an integer {rng}"
+                     + (f" ({what})" if what else ""))

@@ -69,7 +69,7 @@ from rough_contact.interface.contract import (ConvergenceError, InterfaceLawProt
                                               NewtonTangentLaw, SoftenableLaw)
 from rough_contact.interface.enforcement import AugmentedLagrangian, Enforcement, Penalty
 from rough_contact.interface.state import InterfaceHistory, keep_points
-from rough_contact.validation import check_scalar
+from rough_contact.validation import check_integer, check_scalar
 
 __all__ = ["ContactInterface", "InterfaceSummary", "PointFields", "Acceptance"]
 
@@ -180,11 +180,7 @@ class ContactInterface(InterfaceQueries):
         self.enforcement.check_law(law)
         self.first_tag, self.second_tag, self.sliding = first_tag, second_tag, sliding
         self.sliding_tolerance = check_scalar("sliding_tolerance", sliding_tolerance, lo=0.0)
-        if (not isinstance(max_repairs, (int, np.integer)) or isinstance(max_repairs, bool)
-                or max_repairs < 1):
-            raise ValueError(f"max_repairs = {max_repairs!r} is invalid: it must be an integer "
-                             ">= 1")
-        self.max_repairs = int(max_repairs)
+        self.max_repairs = check_integer("max_repairs", max_repairs, lo=1)
         if rigid_motion is not None and not callable(rigid_motion):
             raise TypeError(f"rigid_motion ({type(rigid_motion).__name__}) must be a callable "
                             "load factor -> translation (3,) [mm]")

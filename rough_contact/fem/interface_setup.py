@@ -27,7 +27,7 @@ from rough_contact.fem.rigid import RigidSurface
 from rough_contact.interface.contract import (InterfaceLawProtocol, LawContractError, LawResult,
                                               LawState)
 from rough_contact.interface.enforcement import Enforcement
-from rough_contact.validation import check_scalar
+from rough_contact.validation import check_integer, check_scalar
 
 __all__ = ["check_arguments", "select_pairing", "initial_law_state", "check_result",
            "warn_overconstrained", "RigidPlane"]
@@ -64,10 +64,7 @@ def check_arguments(V, law, first_tag, second_tag, rigid_plane, quadrature_degre
         raise ValueError(f"first_tag and second_tag are both {first_tag}")
     if second_tag is not None and rigid_plane is not None:
         raise ValueError("give either second_tag or rigid_plane, not both")
-    degree = check_scalar("quadrature_degree", quadrature_degree, lo=0, lo_open=False)
-    if degree != int(degree):
-        raise ValueError(f"quadrature_degree = {quadrature_degree!r} is invalid: it must be an "
-                         "integer >= 0")
+    degree = check_integer("quadrature_degree", quadrature_degree, lo=0)
     if quadrature not in ("gauss", "vertex"):
         raise ValueError(f"quadrature = {quadrature!r} is invalid: it must be 'gauss' or 'vertex'")
     if quadrature == "vertex" and element.degree != 1:

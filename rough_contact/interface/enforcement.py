@@ -33,7 +33,7 @@ from typing import Optional, Protocol, Union, runtime_checkable
 
 import numpy as np
 
-from ..validation import check_scalar
+from ..validation import check_integer, check_scalar
 from .contract import (CoulombContactLaw, CoulombLimit, InterfaceLawProtocol, LawResult,
                        MultiplierLaw)
 
@@ -129,10 +129,7 @@ class AugmentedLagrangian:
     def __post_init__(self) -> None:
         check_scalar("augmentation tolerance", self.tolerance, lo=0.0, hi=1.0, hi_open=True)
         check_scalar("stiffness_factor", self.stiffness_factor, lo=0.0)
-        if (not isinstance(self.max_updates, (int, np.integer))
-                or isinstance(self.max_updates, bool) or self.max_updates < 1):
-            raise ValueError(f"max_updates = {self.max_updates!r} is invalid: it must be an "
-                             "integer >= 1")
+        check_integer("max_updates", self.max_updates, lo=1)
 
     def check_law(self, law: InterfaceLawProtocol) -> None:
         """The law must be a MultiplierLaw (its penalty can be shifted)."""
@@ -215,10 +212,7 @@ class NewtonAugmentedLagrangian(AugmentedLagrangian):
         super().__post_init__()
         check_scalar("residual_ratio", self.residual_ratio, lo=0.0, hi=1.0, lo_open=False,
                      hi_open=False)
-        if (not isinstance(self.first_iteration, (int, np.integer))
-                or isinstance(self.first_iteration, bool) or self.first_iteration < 0):
-            raise ValueError(f"first_iteration = {self.first_iteration!r} is invalid: it must "
-                             "be an integer >= 0 (Newton iteration)")
+        check_integer("first_iteration", self.first_iteration, lo=0, what="Newton iteration")
 
 
 @dataclass(frozen=True)

@@ -66,7 +66,7 @@ from typing import Optional, Protocol, Tuple, runtime_checkable
 
 import numpy as np
 
-from ..validation import check_scalar
+from ..validation import check_integer, check_scalar
 from .normal import NormalLaw
 
 __all__ = ["HistoryNormalLawProtocol", "ReversalStiffnessProtocol", "HistoryNormalLaw",
@@ -389,8 +389,7 @@ class HistoryNormalLaw:
         tail = check_scalar("tail", tail, lo=0.0, hi=1e-2)
         for name, v, lo in (("n_rows", n_rows, 3), ("n_x", n_x, 2), ("n_quad", n_quad, 2),
                             ("n_t", n_t, 2), ("n_zeta", n_zeta, 2)):
-            if int(v) != v or v < lo:
-                raise ValueError(f"{name} = {v!r} is invalid: it must be an integer >= {lo}")
+            check_integer(name, v, lo=lo)
         mat = material.resolve(surface)
         if loading is None:
             loading = NormalLaw.elasto_plastic(surface, mat, rtol)

@@ -24,7 +24,7 @@ from typing import Optional, Protocol, Tuple, Union, runtime_checkable
 import numpy as np
 
 from ..validation import check_scalar
-from .contract import LawResult, check_jump
+from .contract import InterfaceLawProtocol, LawResult, check_jump
 from .friction import (FrictionInput, IsotropicSlipHardening, OrthotropicSlipHardening,
                        ShiftedFrictionInput)
 from .history import HistoryNormalLawProtocol, ReversalStiffnessProtocol

@@ -62,6 +62,7 @@ from rough_contact.fem.collective import run_on_root
 from rough_contact.fem.contact import PointFields
 from rough_contact.io.files import (OutputExistsError, atomic_write_text, check_free_space,
                                    parse_xdmf, run_files, writing)
+from rough_contact.validation import check_integer
 
 __all__ = [
     "STATUS_OPEN", "STATUS_STICK", "STATUS_SLIP", "STATUS_NAMES", "InterfaceOutputSource",
@@ -188,8 +189,7 @@ MEMORY_FIELD_NAMES = tuple(n for _, n in _MEMORY)
 
 def _check_points(weights: np.ndarray, n_qp: int) -> np.ndarray:
     w = np.asarray(weights, dtype=float)
-    if int(n_qp) != n_qp or n_qp < 1:
-        raise ValueError(f"n_qp = {n_qp!r} must be an integer >= 1")
+    check_integer("n_qp", n_qp, lo=1)
     if w.ndim != 1 or w.size % n_qp:
         raise ValueError(f"weights of shape {w.shape} must be (n_facets * n_qp,), n_qp = {n_qp}")
     if np.any(~np.isfinite(w)) or np.any(w < 0.0):

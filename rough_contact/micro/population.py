@@ -56,7 +56,7 @@ from scipy import special
 from .asperity import (AsperityMaterial, eccentricity_from_lambda, shape_factors,
                        shape_factors_from_lambda)
 from ..surface import SpectralMoments
-from ..validation import check_scalar
+from ..validation import check_integer, check_scalar
 
 __all__ = ["PopulationResult", "elastic", "elasto_plastic", "elasto_plastic_and_elastic",
            "greenwood_williamson",
@@ -196,10 +196,7 @@ def _separations(surface: SpectralMoments, h):
 
 
 def _check_nquad(n):
-    v = check_scalar("n_quad", n, lo=4, hi=400, lo_open=False, hi_open=False)
-    if v != int(v):
-        raise ValueError(f"n_quad = {n!r} is invalid: it must be an integer in [4, 400]")
-    return int(v)
+    return check_integer("n_quad", n, lo=4, hi=400)
 
 
 @lru_cache(maxsize=16)

@@ -34,6 +34,7 @@ from rough_contact.scenes.meshes.beam import beam_on_base
 from rough_contact.scenes.setup import check_mesh_arguments
 from rough_contact.solver.loading import load_path
 from rough_contact.solver.snes import SNESSolver
+from rough_contact.validation import check_integer
 
 # Silence the INFO lines of the JIT compiler (setuptools resets the root logger's level).
 logging.getLogger().addFilter(lambda record: record.levelno >= logging.WARNING)
@@ -639,8 +640,7 @@ def run(cases=tuple(sorted(CASES)), mesh_size=40.0, contact_size=5.0, order=2,
         raise ValueError(f"hardness = {hardness!r} is invalid; valid values: {HARDNESS}")
     if friction not in ("a", "b", "none"):
         raise ValueError(f"friction = {friction!r} is invalid; valid values: 'a', 'b', 'none'")
-    if int(steps) != steps or steps < 1:
-        raise ValueError(f"steps = {steps!r} must be an integer >= 1")
+    check_integer("steps", steps, lo=1)
     t0 = MPI.Wtime()
     setup = build_scene(comm, mesh_size, contact_size, order, load_half_length)
     if comm.rank == 0:

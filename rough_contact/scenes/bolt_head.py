@@ -42,7 +42,7 @@ from rough_contact.solver.loading import load_path
 from rough_contact.solver.program import (LoadProgram, cycle_boundaries, cycle_summary,
                                          preload_then_cyclic, preload_then_normal_cycles)
 from rough_contact.solver.snes import SNESSolver
-from rough_contact.validation import check_scalar
+from rough_contact.validation import check_integer, check_scalar
 
 __all__ = ["BoltIncrement", "BoltHeadRun", "program", "run", "BoltCyclesRun", "run_cycles"]
 
@@ -117,8 +117,7 @@ def run(pressure=10.0, slide_um=2.0, radius=5.0, height=5.0, size_cylinder=1.0,
     check_scalar("pressure", pressure, lo=0.0, unit="MPa")
     slide = check_scalar("slide", slide_um, lo=0.0, lo_open=False, unit="um") * 1e-3
     for name, n in (("preload_steps", preload_steps), ("shear_steps", shear_steps)):
-        if check_scalar(name, n, lo=1, lo_open=False) != int(n):
-            raise ValueError(f"{name} = {n!r} is invalid: it must be an integer >= 1")
+        check_integer(name, n, lo=1)
     scene = cylinder_on_block(radius=radius, height=height, size_cylinder=size_cylinder,
                               size_block=size_block, order=order, comm=comm)
     V = vector_space(scene.mesh, order)

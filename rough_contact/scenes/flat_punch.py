@@ -43,7 +43,7 @@ from rough_contact.scenes.meshes.flat_punch import flat_punch
 from rough_contact.scenes.setup import check_mesh_arguments, check_points_basis
 from rough_contact.solver.loading import load_path, load_unload_factors
 from rough_contact.solver.snes import SNESSolver
-from rough_contact.validation import check_scalar
+from rough_contact.validation import check_integer, check_scalar
 
 __all__ = ["E", "NU", "TOTAL_FORCE", "MOMENTS_UM", "FRICTION_CASES", "HARDENING", "TABLE5",
            "PLASTIC", "NORMAL_LAWS", "effective_modulus", "make_law", "advise_law",
@@ -292,10 +292,9 @@ def build(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2, load_h
     Returns:
         :class:`PunchModel`.
     """
-    if int(steps) != steps or steps < 1:
-        raise ValueError(f"steps = {steps!r} is invalid: it must be an integer >= 1")
-    if seating_steps is not None and (int(seating_steps) != seating_steps or seating_steps < 1):
-        raise ValueError(f"seating_steps = {seating_steps!r} is invalid: it must be an integer >= 1")
+    check_integer("steps", steps, lo=1)
+    if seating_steps is not None:
+        check_integer("seating_steps", seating_steps, lo=1)
     check_points_basis(points, basis)
     if punch_scene is None:
         punch_scene = quarter_punch(comm, mesh_size, contact_size, order, load_half_width,

@@ -57,7 +57,7 @@ from rough_contact.solver.checkpoint import (CheckpointState, ResumableOutput, r
                                              write_checkpoint)
 from rough_contact.solver.checkpoint import signature as checkpoint_signature
 from rough_contact.solver.snes import SNESSolver, SolveResult
-from rough_contact.validation import check_scalar
+from rough_contact.validation import check_integer, check_scalar
 
 __all__ = ["Increment", "LoadStepError", "FrictionCapacityError", "ModelValidityError",
            "ModelValidityWarning", "load_path", "load_unload_factors"]
@@ -192,13 +192,11 @@ def load_unload_factors(n_load: int, n_unload: Optional[int] = None,
     Returns:
         List of load factors.
     """
-    if check_scalar("n_load", n_load, lo=1, lo_open=False) != int(n_load):
-        raise ValueError(f"n_load = {n_load!r} is invalid: it must be an integer >= 1")
+    check_integer("n_load", n_load, lo=1)
     up = [(i + 1) / n_load for i in range(n_load)]
     if n_unload is None:
         n_unload = n_load - 1
-    if check_scalar("n_unload", n_unload, lo=0, lo_open=False) != int(n_unload):
-        raise ValueError(f"n_unload = {n_unload!r} is invalid: it must be an integer >= 0")
+    check_integer("n_unload", n_unload, lo=0)
     final = 1.0 / n_load if final_factor is None else check_scalar(
         "final_factor", final_factor, lo=0.0, lo_open=False, hi=1.0)
     down = [1.0 - (1.0 - final) * (i + 1) / n_unload for i in range(n_unload)]
@@ -301,8 +299,8 @@ def load_path(problem: ContactProblem, solver: SNESSolver, factors: Iterable[flo
     if validity not in VALIDITY_POLICIES:
         raise ValueError(f"validity = {validity!r} is invalid: it must be one of "
                          f"{', '.join(VALIDITY_POLICIES)}")
-    if max_steps is not None and (int(max_steps) != max_steps or max_steps < 1):
-        raise ValueError(f"max_steps = {max_steps!r} is invalid: it must be an integer >= 1")
+    if max_steps is not None:
+        check_integer("max_steps", max_steps, lo=1)
     stepper = _Stepper(problem, solver, list(factors), min_increment=min_increment,
                        max_growth=max_growth, verbose=verbose, validity=validity,
                        predictor=predictor, friction_check=friction_check)

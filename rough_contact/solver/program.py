@@ -33,7 +33,7 @@ from typing import Callable, Dict, List
 import numpy as np
 
 from rough_contact.cycles import energy_ratio, loop_amplitudes, loop_energies
-from rough_contact.validation import check_scalar
+from rough_contact.validation import check_integer, check_scalar
 
 __all__ = ["LoadProgram", "proportional", "preload_then_hold", "preload_then_cyclic",
            "preload_then_normal_cycles", "cycle_index", "cycle_boundaries", "cycle_summary"]
@@ -55,9 +55,7 @@ class LoadProgram:
 
 
 def _count(name: str, value, lo: int) -> int:
-    if check_scalar(name, value, lo=lo, lo_open=False) != int(value):
-        raise ValueError(f"{name} = {value!r} is invalid: it must be an integer >= {lo}")
-    return int(value)
+    return check_integer(name, value, lo=lo)
 
 
 def proportional(n_load: int, n_unload: int = 0) -> LoadProgram:

@@ -47,7 +47,7 @@ from petsc4py import PETSc
 from rough_contact.fem.problem import ContactProblem, rigid_body_modes
 from rough_contact.interface.contract import ConvergenceError
 from rough_contact.solver.options import default_options, set_default_options, unused_options
-from rough_contact.validation import check_scalar
+from rough_contact.validation import check_integer, check_scalar
 
 __all__ = ["SolveResult", "SNESSolver", "UnusedOptionsWarning", "set_default_options",
            "NewtonIterationHook",
@@ -148,10 +148,9 @@ class Continuation:
             raise ValueError(f"continuation factors = {self.factors!r} are invalid: give at "
                              "least one factor > 1, strictly decreasing (e.g. (100, 10))")
         object.__setattr__(self, "factors", f)
-        if self.after is not None and (not isinstance(self.after, (int, np.integer))
-                                       or isinstance(self.after, bool) or self.after < 0):
-            raise ValueError(f"continuation after = {self.after!r} is invalid: it must be an "
-                             "integer >= 0 (Newton iterations with the law itself)")
+        if self.after is not None:
+            check_integer("continuation after", self.after, lo=0,
+                          what="Newton iterations with the law itself")
 
 
 def _parse_continuation(text: str) -> Optional[Continuation]:
