@@ -6,7 +6,8 @@ against beta/mu, its ring convergence, and the annulus of the Cattaneo–Mindlin
         [--fit-max 1]
 
 Prints, per beta/mu and ring count, c/a at the end of the loading, its spread over the loading
-from a = 0.4 on (self-similarity), the CPU time; then a straight-line fit of ln(1 - c/a)
+from a = 0.4 on (self-similarity), whether the slip zone is one outer annulus at every
+increment from a = 0.4 on ("one ann"), the CPU time; then a straight-line fit of ln(1 - c/a)
 against mu/beta over the finest rings' resolved rows (1 - c/a at least 3 ring widths, beta/mu
 <= --fit-max: the thin-annulus regime) and its
 value at the scene's beta/mu (rigid sphere on an elastic block with --nu and --mu): the
@@ -37,7 +38,8 @@ def main(argv=None):
     scene = beta / args.mu
     print(f"scene: rigid sphere on nu = {args.nu:g}: beta = {beta:.5f}, mu = {args.mu:g}, "
           f"beta/mu = {scene:.4f}")
-    print(f"{'beta/mu':>8} {'rings':>6} {'c/a':>8} {'1-c/a':>9} {'spread':>8} {'CPU s':>7}")
+    print(f"{'beta/mu':>8} {'rings':>6} {'c/a':>8} {'1-c/a':>9} {'spread':>8} {'one ann':>7} "
+          f"{'CPU s':>7}")
     finest = {}
     for ratio in [scene] + list(args.ratios):
         for n in args.rings:
@@ -46,7 +48,10 @@ def main(argv=None):
             cpu = time.process_time() - t0
             late = res.stick_ratio[res.a >= 0.4]
             c = res.stick_ratio[-1]
-            print(f"{ratio:8.4f} {n:6d} {c:8.4f} {1 - c:9.2e} {np.ptp(late):8.4f} {cpu:7.1f}")
+            # one annulus: the innermost slipping ring starts where the outermost stuck ends
+            one = np.allclose(res.inner_slip_ratio[res.a >= 0.4], late, atol=1e-12)
+            print(f"{ratio:8.4f} {n:6d} {c:8.4f} {1 - c:9.2e} {np.ptp(late):8.4f} "
+                  f"{'yes' if one else 'NO':>7} {cpu:7.1f}")
         finest[ratio] = (c, n)
     rows = [(1.0 / r, np.log(1.0 - c)) for r, (c, n) in finest.items()
             if r != scene and r <= args.fit_max and 1.0 - c >= 3.0 / n]

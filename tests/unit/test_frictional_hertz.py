@@ -68,6 +68,17 @@ def test_slip_annulus_is_self_similar(strong):
     assert ratios.max() - ratios.min() <= 1.0 / (0.4 * strong.rings) + 1e-12
 
 
+def test_slip_zone_is_one_outer_annulus(strong):
+    """Spence's structure: a stuck disc inside one slipping annulus. The solver lets every ring
+    stick or slip on its own, so an interleaved pattern would show as the innermost slipping
+    ring lying inside the outermost stuck one; from a = 0.4 on the two edges coincide."""
+    late = strong.a >= 0.4
+    np.testing.assert_allclose(strong.inner_slip_ratio[late], strong.stick_ratio[late],
+                               atol=1e-12)
+    slip = (strong.r < 1.0) & ~strong.sticking
+    assert np.all(strong.r[slip] > strong.r[strong.sticking].max())
+
+
 def test_coulomb_conditions_and_r2_displacement(strong):
     q, p, st = strong.shear, strong.pressure, strong.sticking
     slip = (strong.r < 1.0) & ~st
