@@ -54,7 +54,7 @@ from rough_contact.interface.enforcement import NewtonAugmentedLagrangian, Semis
 from rough_contact.interface.state import InterfaceState
 
 __all__ = ["NodalContactInterface", "NodalPoints", "VertexJumpOperator", "nodal_points",
-           "vertex_shape_matrix"]
+           "quadratic_dual", "vertex_shape_matrix"]
 
 
 @dataclass(frozen=True)
@@ -120,6 +120,61 @@ def dual_matrix(nv: int) -> np.ndarray:
         a = np.array([[2.0, -1.0], [-1.0, 2.0]])
         return np.kron(a, a)          # vertex v = x + 2 y: kron over (y, x) is symmetric here
     raise ValueError(f"a facet with {nv} vertices has no dual basis here (3 or 4)")
+
+
+MODIFIED_P2_ALPHA = 0.2
+"""Popp et al.'s modification of the 6-node triangle's basis for a quadratic dual basis."""
+
+
+def quadratic_dual(facet: str) -> tuple[np.ndarray, np.ndarray]:
+    """The dual (biorthogonal) basis of a quadratic facet's nodal functions, in basix's DOF
+    order: the reference-element piece of a quadratic dual-mortar condensation (design and
+    status: docs/exact_contact_newton.md, "Quadratic dual basis"; the FE condensation on P2/Q2
+    is not built).
+
+    On the 6-node triangle the vertex functions integrate to zero, so no dual basis of the
+    plain functions has positive weights. Popp et al.'s modified functions
+    Ntilde_v = N_v + alpha (N_e + N_e') (the two edges at v), Ntilde_e = (1 - 2 alpha) N_e,
+    alpha = 1/5, still sum to 1 and integrate to 2/15 and 1/5 of the area. The 9-node
+    quadrilateral needs no modification (the functions integrate to 1/36, 1/9, 4/9 of the area):
+    the dual basis is the tensor product of the segment's.
+
+    Args:
+        facet: ``"triangle6"`` (P2 tetrahedra) or ``"quadrilateral9"`` (Q2 hexahedra).
+
+    Returns:
+        T: (n, n) Ntilde_i = sum_k T[i, k] N_k (the identity for ``"quadrilateral9"``); the
+            displacement's coefficients change as u = T^T utilde.
+        A: (n, n) psi_i = sum_k A[i, k] Ntilde_k with int psi_i Ntilde_k dA =
+            delta_ik int Ntilde_k dA on an affine facet; the psi_i sum to 1.
+    """
+    if facet == "triangle6":
+        # basix: vertices 0, 1, 2; DOF 3 + e on edge e, the edge opposite vertex e
+        a = MODIFIED_P2_ALPHA
+        T = np.diag([1.0, 1.0, 1.0, 1.0 - 2 * a, 1.0 - 2 * a, 1.0 - 2 * a])
+        for v in range(3):
+            for e in range(3):
+                if e != v:
+                    T[v, 3 + e] = a
+        # mass matrix of the plain P2 functions on the unit-area triangle, in 1/180: vertex
+        # 6 (itself), -1 (other vertex), -4 (opposite edge), 0 (adjacent edge); edge 32, 16
+        M = np.zeros((6, 6))
+        M[:3, :3] = 7.0 * np.eye(3) - 1.0
+        M[3:, 3:] = 16.0 * np.eye(3) + 16.0
+        M[:3, 3:] = M[3:, :3] = -4.0 * np.eye(3)
+        M /= 180.0
+        Mt = T @ M @ T.T
+    elif facet == "quadrilateral9":
+        # segment [0, 1]: nodes 0, 1, midpoint; mass of the quadratic functions
+        m1 = np.array([[4.0, -1.0, 2.0], [-1.0, 4.0, 2.0], [2.0, 2.0, 16.0]]) / 30.0
+        # basix's 9-node quadrilateral: (x, y) node index per DOF (0, 1: ends, 2: midpoint)
+        xy = [(0, 0), (1, 0), (0, 1), (1, 1), (2, 0), (0, 2), (1, 2), (2, 1), (2, 2)]
+        T = np.eye(9)
+        Mt = np.array([[m1[i[0], j[0]] * m1[i[1], j[1]] for j in xy] for i in xy])
+    else:
+        raise ValueError(f"facet = {facet!r} is invalid: 'triangle6' or 'quadrilateral9'")
+    D = np.diag(Mt.sum(axis=1))            # int Ntilde_k dA (the functions sum to 1)
+    return T, D @ np.linalg.inv(Mt)
 
 
 def nodal_points(ctx: SurfaceContext, paired: PairedPoints, op: JumpOperator,

@@ -217,3 +217,30 @@ def test_mindlin_enforcement_and_augmented_refused():
     with pytest.raises(ValueError, match="enforcement = .* with augmented = True is invalid"):
         mindlin.run(points="nodal", basis="dual", augmented=True,
                     enforcement=NewtonAugmentedLagrangian(1e-4))
+
+
+@pytest.mark.parametrize("facet, cell, area", [("triangle6", "triangle", 0.5),
+                                               ("quadrilateral9", "quadrilateral", 1.0)])
+def test_quadratic_dual_is_biorthogonal_to_basix_functions(facet, cell, area):
+    """The quadratic dual basis against basix's own P2/Q2 functions, integrated by a rule
+    exact for their products (the hand-written mass matrices and DOF order are what is checked):
+    int psi_i Ntilde_k = delta_ik int Ntilde_k, the psi_i sum to 1, the modified functions
+    integrate to positive weights (2/15 and 1/5 of the triangle's area; the 9-node
+    quadrilateral's 1/36, 1/9, 4/9 unmodified)."""
+    import basix
+    from rough_contact.fem.nodal import quadratic_dual
+    T, A = quadratic_dual(facet)
+    ct = getattr(basix.CellType, cell)
+    X, w = basix.make_quadrature(ct, 8)
+    N = basix.create_element(basix.ElementFamily.P, ct, 2,
+                             basix.LagrangeVariant.equispaced).tabulate(0, X)[0, :, :, 0].T
+    Nt, psi = T @ N, A @ T @ N
+    m = Nt @ w
+    np.testing.assert_allclose((psi * w) @ Nt.T, np.diag(m), atol=1e-14)
+    np.testing.assert_allclose(psi.sum(axis=0), 1.0, atol=1e-13)
+    np.testing.assert_allclose(Nt.sum(axis=0), 1.0, atol=1e-13)
+    expect = ([2 / 15] * 3 + [1 / 5] * 3 if facet == "triangle6"
+              else [1 / 36] * 4 + [1 / 9] * 4 + [4 / 9])
+    np.testing.assert_allclose(m / area, expect, rtol=1e-13)
+    with pytest.raises(ValueError, match="facet = 'triangle3' is invalid"):
+        quadratic_dual("triangle3")
