@@ -33,7 +33,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from rough_contact import references
-from rough_contact.interface.enforcement import NewtonAugmentedLagrangian
+from rough_contact.interface.enforcement import NewtonAugmentedLagrangian, SemismoothNewton
 from rough_contact.scenes import mindlin
 from rough_contact.stick_front import mindlin_tractions, stick_front
 
@@ -91,8 +91,11 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--points", default="nodal", choices=["nodal", "quadrature"])
     ap.add_argument("--plain", action="store_true", help="plain penalty (no augmentation)")
-    ap.add_argument("--basis", default="standard", choices=["standard", "dual"])
-    ap.add_argument("--enforcement", default="uzawa", choices=["uzawa", "newton"])
+    ap.add_argument("--basis", default="standard",
+                    choices=["standard", "dual", "dual_quadratic"])
+    ap.add_argument("--enforcement", default="uzawa", choices=["uzawa", "newton", "ssn"],
+                    help="uzawa: AugmentedLagrangian; newton: NewtonAugmentedLagrangian; "
+                         "ssn: SemismoothNewton (needs --basis dual_quadratic on P2)")
     ap.add_argument("--residual-ratio", type=float, default=1e-2,
                     help="NewtonAugmentedLagrangian.residual_ratio (--enforcement newton)")
     ap.add_argument("--contact-size", type=float, default=0.05)
@@ -119,9 +122,14 @@ def main(argv=None):
     ap.add_argument("--save", default=None, help="write the gathered points to this .npz")
     ap.add_argument("--verbose", action="store_true")
     args = ap.parse_args(argv)
-    newton = args.enforcement == "newton" and not args.plain
-    enforcement = NewtonAugmentedLagrangian(args.al_tol, 60, residual_ratio=args.residual_ratio) \
-        if newton else None
+    newton = args.enforcement in ("newton", "ssn") and not args.plain
+    if args.enforcement == "ssn" and not args.plain:
+        enforcement = SemismoothNewton()
+    elif newton:
+        enforcement = NewtonAugmentedLagrangian(args.al_tol, 60,
+                                                residual_ratio=args.residual_ratio)
+    else:
+        enforcement = None
     t0, c0 = time.perf_counter(), time.process_time()
     r = mindlin.run(contact_size=args.contact_size, order=2, nu=args.nu,
                     preload_steps=args.preload_steps, shear_steps=args.shear_steps,

@@ -34,6 +34,15 @@ the weighted jumps and L, L_g per-vertex 3 x 3 blocks:
 computed as one sparse product [L | L_g] [K; G] with patterns fixed at set-up (K and G do not
 change under small sliding; only the blocks of L on the vertices' rows change per iteration).
 
+P2/Q2 (``basis="dual_quadratic"``). A point at every first-surface node, weighted by the
+quadratic dual basis of Popp's modified functions Ntilde = T N
+(``rough_contact.fem.nodal.quadratic_dual``). An edge node's weighted jump then reaches the
+edge's end vertices too, and row k of the residual carries sum_j (T^-1)_kj s_j m_j R_j^T t_j.
+The rows are therefore first combined by T (F -> T F, a parallel matrix that is the identity
+away from the surface and on Dirichlet components). Each combined row j carries
+s_j m_j R_j^T t_j alone, and everything above applies to T F_b. The Jacobian becomes
+[L | L_g] [T K; G], where T K is formed once. Derivation: docs/exact_contact_newton.md, section 4.
+
 Dirichlet components. A component of vertex j fixed by a Dirichlet condition is a symmetry
 plane through it (``rough_contact.fem.nodal``): its row stays the Dirichlet row, its traction
 component is zero, and the vertex frame must have an axis along it (true on a flat surface
@@ -82,8 +91,10 @@ class DualCondensation:
     """The condensation's constant data and its per-iteration products (module docstring).
 
     Args:
-        V: the displacement space (P1/Q1); nodal: the vertex points
-            (``rough_contact.fem.nodal.NodalPoints``, dual basis); rows: (n_v, nd) global
+        V: the displacement space (P1/Q1, or P2/Q2 with the quadratic dual basis); nodal:
+            the vertex points (``rough_contact.fem.nodal.NodalPoints``, basis ``"dual"``, or
+            ``"dual_quadratic"``: a point at every first-surface node, whose rows are combined
+            by T, docs/exact_contact_newton.md section 4); rows: (n_v, nd) global
             rows of each vertex's DOFs, -1 for Dirichlet and padding columns (the vertex jump
             operator's); friction: Coulomb's mu; r_normal, r_tangential: the augmentation
             parameters [MPa/mm] (None: per vertex, the mean diagonal of the bulk matrix K over
@@ -121,7 +132,30 @@ class DualCondensation:
         # the jump is second minus first surface: the own coefficient is -I (or +I)
         sign = np.where(np.einsum("vii->v", A_own) < 0.0, -1.0, 1.0)
         want = np.where(fixed[:, :, None], 0.0, sign[:, None, None] * np.eye(3)[None])
-        if n_v and bad == 0:
+        comb = nodal.combination
+        first = own.copy()           # the first surface's columns of each vertex's jump
+        if comb is not None:
+            # quadratic dual basis: an edge node's jump also reaches its end vertices, and
+            # the combined rows T F carry one traction each (docs/exact_contact_newton.md,
+            # section 4); checked: isotropic blocks, sum over the first surface's columns =
+            # sign (rigid translation), own coefficient x T_jj = sign
+            every = np.concatenate(comm.allgather(nodal.vertex))
+            first = np.isin(nodal.nodes, every) & ~nodal.pad
+            t_jj = np.ones(n_v)
+            diag = comb.row == comb.col
+            t_jj[np.searchsorted(nodal.vertex, comb.row[diag])] = comb.value[diag]
+            A1 = np.where(first[:, :, None, None], A, 0.0) / self.m[:, None, None, None]
+            free = ~fixed
+            iso = np.abs(A1 - np.einsum("vkii->vki", A1)[..., None] * np.eye(3)).max(
+                axis=(1, 3)) if n_v else np.zeros((0, 3))
+            total = np.einsum("vkii->vi", A1)
+            own_d = np.einsum("vii->vi", A_own) * t_jj[:, None]
+            if n_v and bad == 0:
+                bad = int(np.sum(np.any(free & ((iso > 1e-9) | (np.abs(total - sign[:, None])
+                                                                 > 1e-9)
+                                                | (np.abs(own_d - sign[:, None]) > 1e-9)),
+                                        axis=1)))
+        elif n_v and bad == 0:
             bad = int(np.sum(np.abs(A_own - want).max(axis=(1, 2)) > 1e-9))
         # a fixed component must be along a frame axis: |R[k, i]| = 1 for some k
         if n_v and np.any(fixed):
@@ -132,15 +166,16 @@ class DualCondensation:
             raise ValueError(
                 f"{n_bad} contact vertices cannot be condensed: the semismooth Newton needs "
                 "the first surface's weighted jump to be the identity on the vertex's own DOFs "
-                "(P1 displacements, or Q1 on parallelogram facets, with basis='dual': the dual "
-                "basis is biorthogonal there) and every Dirichlet component of a "
+                "(P1 displacements, or Q1 on parallelogram facets, with basis='dual'; P2, or Q2 "
+                "on parallelogram facets, with basis='dual_quadratic': the dual bases are "
+                "biorthogonal there) and every Dirichlet component of a "
                 "contact vertex along an axis of its frame (a symmetry plane at right angles)")
         self.fixed = fixed
         self.sign = sign
         self.S_rows = S_rows
         self.S_local = (S_rows - s0).astype(np.int64)
-        # second surface: the columns other than the vertex's own, their global rows
-        partner = ~own & ~nodal.pad                                               # (v, w)
+        # second surface: the columns other than the first surface's, their global rows
+        partner = ~first & ~nodal.pad                                             # (v, w)
         self.partner = partner
         A_M = np.where(partner[:, :, None, None], A, 0.0)                         # (v,w,i,c)
         A_M = np.where(fixed[:, None, :, None], 0.0, A_M)    # a fixed jump component: zero
@@ -164,6 +199,45 @@ class DualCondensation:
         self.r_normal = stiffness if r_normal is None else np.full(n_v, float(r_normal))
         self.r_tangential = self.r_normal if r_tangential is None else \
             np.full(n_v, float(r_tangential))
+        self._T = self._tmp = None
+        if comb is not None:
+            self._T = self._combination(comb, nodal.vertex, fixed)
+
+    def _combination(self, comb, vertex: np.ndarray, fixed: np.ndarray) -> PETSc.Mat:
+        """T as a parallel matrix on the displacement's rows: the identity but on the first
+        surface's free components, whose rows combine those of their facets' nodes (the
+        owner of a row builds it; collective). Raises ValueError on every rank if a free
+        component would take a fixed one's row."""
+        nl, s0 = self.n_local, self.start
+        node_fixed = fixed[np.searchsorted(vertex, comb.row)]                     # (n, 3)
+        r = (3 * comb.row[:, None] + np.arange(3)).reshape(-1)
+        c = (3 * comb.col[:, None] + np.arange(3)).reshape(-1)
+        v = np.repeat(comb.value, 3)
+        row_fixed = node_fixed.reshape(-1)
+        col_fixed = comb.col_fixed.reshape(-1)
+        same = r == c
+        n_bad = self.comm.allreduce(int(np.sum(~row_fixed & col_fixed & ~same)), op=MPI.SUM)
+        if n_bad:
+            raise ValueError(f"{n_bad} free components of contact nodes would combine with a "
+                             "Dirichlet row (the quadratic dual condensation supports "
+                             "symmetry planes through whole facet edges only)")
+        keep = ~row_fixed & ~col_fixed
+        r, c, v = r[keep], c[keep], v[keep]
+        # identity rows: every local row not combined (fixed components included)
+        combined = np.zeros(nl, dtype=bool)
+        combined[r - s0] = True
+        ident = np.flatnonzero(~combined) + s0
+        r = np.concatenate([r, ident])
+        c = np.concatenate([c, ident])
+        v = np.concatenate([v, np.ones(ident.size)])
+        order = np.lexsort((c, r))
+        r, c, v = r[order] - s0, c[order], v[order]
+        indptr = np.concatenate([[0], np.cumsum(np.bincount(r, minlength=nl))])
+        T = PETSc.Mat().createAIJ(size=((nl, self.n_glob), (nl, self.n_glob)),
+                                  csr=(indptr.astype(PETSc.IntType), c.astype(PETSc.IntType),
+                                       v), comm=self.comm)
+        T.assemble()
+        return T
 
     # ------------------------------------------------------------------ the residual
     def tractions(self, F_S: np.ndarray) -> np.ndarray:
@@ -175,6 +249,11 @@ class DualCondensation:
                  ) -> tuple[np.ndarray, ComplementarityResult]:
         """Replace b = F_b by H (no assembly of the second surface's rows; see
         :meth:`add_partner_rows`); returns (t, the complementarity result)."""
+        if self._T is not None:          # the combined rows T F_b (collective)
+            if self._tmp is None:
+                self._tmp = b.duplicate()
+            self._T.mult(b, self._tmp)
+            self._tmp.copy(b)
         arr = b.array
         F_S = arr[self.S_local] if self.n_v else np.zeros((0, 3))
         t = self.tractions(F_S)
@@ -201,7 +280,12 @@ class DualCondensation:
     def _build(self, K: PETSc.Mat) -> None:
         """[K; G] and the pattern of [L | L_g] (once; collective)."""
         comm, nl, s0 = self.comm, self.n_local, self.start
-        ai, aj, av = K.getValuesCSR()
+        if self._T is not None:         # [T K; G]: K is constant (linear bulk)
+            TK = self._T.matMult(K)
+            ai, aj, av = TK.getValuesCSR()
+            TK.destroy()
+        else:
+            ai, aj, av = K.getValuesCSR()
         gr, gc, gv = self._G
         order = np.argsort(gr, kind="stable")
         gr, gc, gv = gr[order] - s0, gc[order], gv[order]

@@ -20,6 +20,12 @@ displacements and avoids the P2 triangle's corner functions of zero integral (wh
 dual basis). Because the N_j are a partition of unity, a uniform traction gives exactly the
 quadrature route's residual: the patch test passes wherever the pairing passes it.
 
+``basis="dual_quadratic"`` (P2/Q2) instead puts a point at every first-surface node, weighted
+by Popp's modified quadratic functions and their dual basis (:func:`quadratic_dual`). This is
+what lets the semismooth Newton condense the tractions on P2/Q2
+(``rough_contact.fem.condensation``). Its nodal tractions are noisier than the vertex set's
+on a curved contact (docs/exact_contact_newton.md, section 4).
+
 Each vertex row combines the rows of all the vertex's facets (and their partners): one
 "group" per vertex with a variable number of DOFs, padded to the rank's largest count with
 zero columns whose matrix rows are skipped (-1). A vertex shared by facets on several ranks is
@@ -37,7 +43,7 @@ Units: mm, N, MPa.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Sequence
+from typing import Optional, Sequence
 
 import basix
 import numpy as np
@@ -70,6 +76,8 @@ class NodalPoints:
         B: (n_v, 3, 3 m) rows of the weighted jump on the vertex's DOFs.
         nodes: (n_v, m) global block indices of those DOFs (padded with the first node).
         pad: (n_v, m) True for padding columns (B = 0 there).
+        fixed: (n_v, 3) the vertex's components fixed by a Dirichlet condition (mirrored).
+        combination: the rows of T with ``basis="dual_quadratic"``, else None.
     """
 
     vertex: np.ndarray
@@ -80,6 +88,21 @@ class NodalPoints:
     B: np.ndarray
     nodes: np.ndarray
     pad: np.ndarray
+    fixed: Optional[np.ndarray] = None
+    combination: Optional["RowCombination"] = None
+
+
+@dataclass(frozen=True)
+class RowCombination:
+    """The rows of T (Ntilde = T N, :func:`quadratic_dual`) owned by this rank, for the
+    quadratic dual basis's condensation (docs/exact_contact_newton.md, section 4): entry
+    (row node, column node, value) in global block indices; ``col_fixed`` (n, 3): the column
+    node's components fixed by a Dirichlet condition."""
+
+    row: np.ndarray
+    col: np.ndarray
+    value: np.ndarray
+    col_fixed: np.ndarray
 
 
 def vertex_shape_matrix(V) -> tuple[np.ndarray, np.ndarray]:
@@ -122,6 +145,10 @@ def dual_matrix(nv: int) -> np.ndarray:
     raise ValueError(f"a facet with {nv} vertices has no dual basis here (3 or 4)")
 
 
+BASES = ("standard", "dual", "dual_quadratic")
+"""The nodal point set's bases: first-order vertex functions N_j, their dual basis, or a
+multiplier at every first-surface node of P2/Q2 with the quadratic dual basis."""
+
 MODIFIED_P2_ALPHA = 0.2
 """Popp et al.'s modification of the 6-node triangle's basis for a quadratic dual basis."""
 
@@ -129,8 +156,7 @@ MODIFIED_P2_ALPHA = 0.2
 def quadratic_dual(facet: str) -> tuple[np.ndarray, np.ndarray]:
     """The dual (biorthogonal) basis of a quadratic facet's nodal functions, in basix's DOF
     order: the reference-element piece of a quadratic dual-mortar condensation (design and
-    status: docs/exact_contact_newton.md, "Quadratic dual basis"; the FE condensation on P2/Q2
-    is not built).
+    status: docs/exact_contact_newton.md, section 4; used by ``basis="dual_quadratic"``).
 
     On the 6-node triangle the vertex functions integrate to zero, so no dual basis of the
     plain functions has positive weights. Popp et al.'s modified functions
@@ -177,6 +203,53 @@ def quadratic_dual(facet: str) -> tuple[np.ndarray, np.ndarray]:
     return T, D @ np.linalg.inv(Mt)
 
 
+def quadratic_shape_matrix(V) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The modified quadratic functions and their dual basis in V's facet-closure order.
+
+    Returns:
+        M: (n_lf, n_close, n_close): M[lf, k, i] = T[i, k], Ntilde_i = sum_k M[lf, k, i] phi_k
+            (T of :func:`quadratic_dual`, permuted to the closure's order of facet lf).
+        closure_index: (n_lf, n_close): the multiplier of closure DOF k sits at node k.
+        D: (n_lf, n_close, n_close): psi_i = sum_k Ntilde_k D[lf, k, i].
+
+    Raises:
+        ValueError: V is not a degree-2 Lagrange space on tetrahedra or hexahedra.
+    """
+    element = V.element.basix_element
+    cell = basix_cell(V.mesh)
+    if element.degree != 2 or cell not in (basix.CellType.tetrahedron,
+                                           basix.CellType.hexahedron):
+        raise ValueError(f"basis = 'dual_quadratic' needs P2 or Q2 displacements (degree 2 on "
+                         f"tetrahedra or hexahedra); got degree {element.degree} on "
+                         f"{cell.name}")
+    facet = "triangle6" if cell == basix.CellType.tetrahedron else "quadrilateral9"
+    T_ref, A_ref = quadratic_dual(facet)
+    closure = np.array(element.entity_closure_dofs[2])          # (n_lf, n_close)
+    facet_vertices = np.array(basix.topology(cell)[2])          # (n_lf, nv)
+    corners = np.asarray(basix.geometry(cell))
+    X = np.asarray(element.points)
+    n_lf, n_close = closure.shape
+    nv = facet_vertices.shape[1]
+    # reference-facet nodes in quadratic_dual's order, as pairs of facet vertices whose
+    # midpoint the node is (a vertex: the pair (i, i)); the centre of a quadrilateral last
+    pairs = ([(0, 0), (1, 1), (2, 2), (1, 2), (0, 2), (0, 1)] if nv == 3 else
+             [(0, 0), (1, 1), (2, 2), (3, 3), (0, 1), (0, 2), (1, 3), (2, 3), (0, 3)])
+    M = np.zeros((n_lf, n_close, n_close))
+    D = np.zeros((n_lf, n_close, n_close))
+    for lf in range(n_lf):              # set-up, over the cell's 4 or 6 reference facets
+        c = corners[facet_vertices[lf]]
+        ref_x = np.array([0.5 * (c[a] + c[b]) for a, b in pairs])
+        dist = np.linalg.norm(X[closure[lf]][:, None, :] - ref_x[None, :, :], axis=2)
+        perm = np.argmin(dist, axis=1)                          # closure k -> reference node
+        if not np.allclose(dist[np.arange(n_close), perm], 0.0) or \
+                np.unique(perm).size != n_close:
+            raise ValueError("the P2/Q2 element's facet nodes are not at the facet's vertices, "
+                             "edge midpoints and centre: no quadratic dual basis")
+        M[lf] = T_ref[np.ix_(perm, perm)].T
+        D[lf] = A_ref[np.ix_(perm, perm)].T
+    return M, np.tile(np.arange(n_close), (n_lf, 1)), D
+
+
 def nodal_points(ctx: SurfaceContext, paired: PairedPoints, op: JumpOperator,
                  basis: str = "standard") -> NodalPoints:
     """The vertex points of the first surface from the pairing's points (collective).
@@ -186,7 +259,10 @@ def nodal_points(ctx: SurfaceContext, paired: PairedPoints, op: JumpOperator,
             per-point rows and the DOFs of its groups; Dirichlet rows are not used).
         basis: the weight of the vertex jumps: ``"standard"`` (N_j) or ``"dual"`` (the
             biorthogonal psi_j of :func:`dual_matrix`; the weights m_j and normals stay those
-            of N_j, int psi_j = int N_j). With P1 displacements the dual weighted jump of
+            of N_j, int psi_j = int N_j); or ``"dual_quadratic"`` (P2/Q2 only): a point at
+            every node of the first surface, the weights m_j and normals those of Popp's
+            modified functions Ntilde_j, the jumps weighted by their dual basis
+            (:func:`quadratic_shape_matrix`); ``combination`` then holds the rows of T. With P1 displacements the dual weighted jump of
             vertex j involves the first surface's DOFs of j alone (and, on a conforming
             pairing, the second's of its partner alone): entries below 1e-12 m_j are dropped,
             a sparser Jacobian.
@@ -195,16 +271,24 @@ def nodal_points(ctx: SurfaceContext, paired: PairedPoints, op: JumpOperator,
         ValueError (every rank): a vertex with zero weight.
     """
     V, comm = ctx.V, ctx.comm
-    M, vclose = vertex_shape_matrix(V)
+    if basis not in BASES:
+        raise ValueError(f"basis = {basis!r} is invalid: one of {', '.join(BASES)}")
+    if basis == "dual_quadratic":
+        M, vclose, Dq = quadratic_shape_matrix(V)
+    else:
+        M, vclose = vertex_shape_matrix(V)
     lf = ctx.geo1.local_facet
     n_f, nq = paired.facets.size, paired.n_qp
     nv = M.shape[2]
     Nv = np.einsum("fqk,fkv->fqv", paired.N1, M[lf])                  # (n_f, nq, nv)
     vid = np.take_along_axis(paired.nodes1, vclose[lf], axis=1)       # (n_f, nv)
     c = paired.weights.reshape(n_f, nq, 1) * Nv                       # w_q N_j(x_q)
-    if basis not in ("standard", "dual"):
-        raise ValueError(f"basis = {basis!r} is invalid: 'standard' or 'dual'")
-    cj = c if basis == "standard" else c @ dual_matrix(nv)            # the jump's weights
+    if basis == "standard":                                           # the jump's weights
+        cj = c
+    elif basis == "dual":
+        cj = c @ dual_matrix(nv)
+    else:
+        cj = np.einsum("fqk,fki->fqi", c, Dq[lf])
     R = paired.frames.reshape(n_f, nq, 3, 3)
     jump0 = paired.jump0.copy()
     jump0[:, 0] += op.gap0
@@ -237,6 +321,17 @@ def nodal_points(ctx: SurfaceContext, paired: PairedPoints, op: JumpOperator,
                 + np.arange(3))
     pos = np.minimum(np.searchsorted(flat, own_dofs), max(flat.size - 1, 0))
     f_fixed = (op._rows.reshape(-1)[pos] < 0) if flat.size else np.zeros((0, nv, 3), bool)
+    if basis == "dual_quadratic":
+        # the row combinations T (Ntilde = T N) per facet: (row node, column node, T, the
+        # column node's fixed components), sent with the rest to the row node's owner
+        gi, gk, gl = np.nonzero(np.swapaxes(M[lf[group_facet]], 1, 2))   # (g, row i, col k)
+        q_row = vid[group_facet[gi], gk].astype(np.int64)
+        q_col = vid[group_facet[gi], gl].astype(np.int64)
+        q_val = M[lf[group_facet[gi]], gl, gk]
+        q_fix = f_fixed.reshape(n_g, nv, 3)[gi, gl]
+    else:
+        q_row = q_col = np.zeros(0, dtype=np.int64)
+        q_val, q_fix = np.zeros(0), np.zeros((0, 3), dtype=bool)
     f_vid = vid[group_facet].reshape(-1)
     f_fixed = f_fixed.reshape(-1, 3)
     keep = np.any(t_val != 0.0, axis=(1, 2))
@@ -250,9 +345,18 @@ def nodal_points(ctx: SurfaceContext, paired: PairedPoints, op: JumpOperator,
     a_vals = np.concatenate([vid.reshape(-1, 1).astype(float), m_fv.reshape(-1, 1),
                              n_fv.reshape(-1, 3), j0_fv.reshape(-1, 3)], axis=1)
     dest_f = np.searchsorted(ranges, f_vid, side="right") - 1
+    dest_q = np.searchsorted(ranges, q_row, side="right") - 1
     send = [(a_vals[dest_v == r], t_vid[dest_t == r], t_node[dest_t == r], t_val[dest_t == r],
-             f_vid[dest_f == r], f_fixed[dest_f == r]) for r in range(comm.size)]
+             f_vid[dest_f == r], f_fixed[dest_f == r], q_row[dest_q == r], q_col[dest_q == r],
+             q_val[dest_q == r], q_fix[dest_q == r]) for r in range(comm.size)]
     recv = comm.alltoall(send)
+    q_row = np.concatenate([r[6] for r in recv]).astype(np.int64)
+    q_col = np.concatenate([r[7] for r in recv]).astype(np.int64)
+    q_val = np.concatenate([r[8] for r in recv]).astype(float)
+    q_fix = np.concatenate([r[9] for r in recv]).reshape(-1, 3).astype(bool)
+    _, first = np.unique(np.stack([q_row, q_col]), axis=1, return_index=True)
+    combination = RowCombination(q_row[first], q_col[first], q_val[first], q_fix[first]) \
+        if basis == "dual_quadratic" else None
     a_vals = np.concatenate([r[0] for r in recv])
     a_vid = a_vals[:, 0].astype(np.int64)
     t_vid = np.concatenate([r[1] for r in recv]).astype(np.int64)
@@ -276,7 +380,7 @@ def nodal_points(ctx: SurfaceContext, paired: PairedPoints, op: JumpOperator,
                      for k in range(9)], axis=1).reshape(-1, 3, 3) if ukey.size else \
         np.zeros((0, 3, 3))
     kv, kn = ukey // n_glob, ukey % n_glob
-    if basis == "dual":     # biorthogonality: the other first-surface DOFs vanish (round-off)
+    if basis != "standard":  # biorthogonality: the other first-surface DOFs vanish (round-off)
         big = np.abs(vals).reshape(-1, 9).max(axis=1, initial=0.0) > 1e-12 * m[kv]
         ukey, vals, kv, kn = ukey[big], vals[big], kv[big], kn[big]
     counts = np.bincount(kv, minlength=n_v)
@@ -305,7 +409,7 @@ def nodal_points(ctx: SurfaceContext, paired: PairedPoints, op: JumpOperator,
     B = np.einsum("vai,vikc->vakc", frames, A).reshape(n_v, 3, 3 * width) / m[:, None, None]
     j0 = np.einsum("vai,vi->va", frames, sums[:, 3:]) / m[:, None]
     return NodalPoints(vertex=verts, x=x, weights=m, frames=frames, jump0=j0, B=B,
-                       nodes=nodes, pad=pad)
+                       nodes=nodes, pad=pad, fixed=fixed, combination=combination)
 
 
 class VertexJumpOperator(JumpOperator):
@@ -370,9 +474,10 @@ class NodalContactInterface(ContactInterface):
 
     def __init__(self, V, facet_tags, first_tag, second_tag=None, basis: str = "standard",
                  **kwargs):
-        if basis not in ("standard", "dual"):
+        if basis not in BASES:
             raise ValueError(f"basis = {basis!r} is invalid: 'standard' (the vertex functions "
-                             "N_j) or 'dual' (their biorthogonal basis)")
+                             "N_j), 'dual' (their biorthogonal basis) or 'dual_quadratic' (a "
+                             "point at every node of P2/Q2, the quadratic dual basis)")
         self.basis = basis
         sliding = kwargs.get("sliding", "small")
         if sliding != "small":
@@ -381,12 +486,11 @@ class NodalContactInterface(ContactInterface):
         enforcement = kwargs.get("enforcement")
         if isinstance(enforcement, SemismoothNewton):
             degree = V.element.basix_element.degree
-            if basis != "dual" or degree != 1:
+            if (basis, degree) not in (("dual", 1), ("dual_quadratic", 2)):
                 raise ValueError(
-                    f"the semismooth Newton enforcement condenses the tractions through the "
-                    f"dual basis on first-order displacements: basis = {basis!r} (must be "
-                    f"'dual') with displacement degree {degree} (must be 1: P1 or Q1); for "
-                    "P2/Q2 use NewtonAugmentedLagrangian")
+                    f"the semismooth Newton enforcement condenses the tractions through a "
+                    f"dual basis: basis = {basis!r} with displacement degree {degree}; it "
+                    "needs basis = 'dual' on P1/Q1 or basis = 'dual_quadratic' on P2/Q2")
         super().__init__(V, facet_tags, first_tag, second_tag, **kwargs)
         self.newton_updates = 0      # multiplier updates inside Newton iterations (all solves)
         self._condensation = None    # built at the first condensed_matrix (Dirichlet rows final)

@@ -62,9 +62,10 @@ def check_points_basis(points, basis):
     same check on every rank, before any collective call)."""
     if points not in ("quadrature", "nodal"):
         raise ValueError(f"points = {points!r} is invalid: 'quadrature' or 'nodal'")
-    if basis not in ("standard", "dual"):
-        raise ValueError(f"basis = {basis!r} is invalid: 'standard' (the vertex functions) "
-                         "or 'dual' (their biorthogonal basis)")
+    if basis not in ("standard", "dual", "dual_quadratic"):
+        raise ValueError(f"basis = {basis!r} is invalid: 'standard' (the vertex functions), "
+                         "'dual' (their biorthogonal basis) or 'dual_quadratic' (every node "
+                         "of P2/Q2, the quadratic dual basis)")
     if basis != "standard" and points != "nodal":
         raise ValueError(f"basis = {basis!r} is invalid with points = {points!r}: the basis "
                          "weighs the nodal set's vertex jumps, use points='nodal' (or "

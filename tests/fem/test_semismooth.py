@@ -11,7 +11,10 @@
   dissipation history and vertex tractions as the multipliers updated inside Newton
   (``NewtonAugmentedLagrangian``, a different iteration whose fixed point is the same up to
   its softplus smoothing), in fewer Newton iterations; serial = 2 ranks.
-* Refusals: the standard basis, P2 displacements.
+* P2/Q2 with the quadratic dual basis (``basis="dual_quadratic"``: a point at every node of
+  the first surface, rows combined by T; docs/exact_contact_newton.md, section 4): the same
+  patch test (conforming and mortar P2, conforming Q2) and the Jacobian check (mortar P2).
+* Refusals: the standard basis; the first-order dual basis on P2, the quadratic on P1.
 
 Run serial and in parallel:
     .venv/bin/python -m pytest tests/fem/test_semismooth.py
@@ -56,8 +59,8 @@ def _blocks(comm, pairing, cell_type="tetrahedron", order=1, basis="dual", shear
     return problem, ci
 
 
-def _patch(comm, pairing, cell_type):
-    problem, ci = _blocks(comm, pairing, cell_type)
+def _patch(comm, pairing, cell_type, order=1, basis="dual"):
+    problem, ci = _blocks(comm, pairing, cell_type, order=order, basis=basis)
     solver = SNESSolver(problem, prefix="test_semismooth_")
     incs = list(load_path(problem, solver, [0.5, 1.0], verbose=False))
     pf = ci.point_fields()
@@ -72,25 +75,35 @@ def _patch(comm, pairing, cell_type):
     return out
 
 
-@pytest.mark.parametrize("pairing,cell", [("conforming", "tetrahedron"),
-                                          ("mortar", "tetrahedron"), ("conforming", "hexahedron")])
-def test_patch_exact_and_rank_independent(pairing, cell):
-    world = _patch(MPI.COMM_WORLD, pairing, cell)
+PATCH = [("conforming", "tetrahedron", 1, "dual"), ("mortar", "tetrahedron", 1, "dual"),
+         ("conforming", "hexahedron", 1, "dual"),
+         ("conforming", "tetrahedron", 2, "dual_quadratic"),
+         ("mortar", "tetrahedron", 2, "dual_quadratic"),
+         ("conforming", "hexahedron", 2, "dual_quadratic")]
+
+
+@pytest.mark.parametrize("pairing,cell,order,basis", PATCH,
+                         ids=lambda c: c if isinstance(c, str) else f"P{c}")
+def test_patch_exact_and_rank_independent(pairing, cell, order, basis):
+    """P1/Q1 with the dual basis; P2/Q2 with the quadratic dual basis (a point at every
+    first-surface node, the rows combined by T)."""
+    world = _patch(MPI.COMM_WORLD, pairing, cell, order, basis)
     assert all(i.cutbacks == 0 and i.newton_total <= 2 for i in world["incs"])
     np.testing.assert_allclose(world["pressure"], PRESSURE, rtol=0, atol=1e-9 * PRESSURE)
     assert np.max(np.abs(world["shear"])) <= 1e-9 * PRESSURE and world["slipping"] == 0
     assert np.max(np.abs(world["gap"])) <= 1e-14      # closed exactly (mm; u ~ 1e-4 mm)
     np.testing.assert_allclose(world["force"], [0.0, 0.0, PRESSURE], atol=1e-9 * PRESSURE)
-    serial = _patch(MPI.COMM_SELF, pairing, cell)
+    serial = _patch(MPI.COMM_SELF, pairing, cell, order, basis)
     np.testing.assert_allclose(world["pressure"], serial["pressure"], rtol=0,
                                atol=1e-10 * PRESSURE)
 
 
-def test_condensed_jacobian_against_finite_differences():
+@pytest.mark.parametrize("order,basis", [(1, "dual"), (2, "dual_quadratic")])
+def test_condensed_jacobian_against_finite_differences(order, basis):
     """J v = (H(u + e v) - H(u - e v)) / 2e at a state with open, sticking and slipping
     vertices (a random displacement near the contact state; no branch changes within e)."""
     comm = MPI.COMM_WORLD
-    problem, ci = _blocks(comm, "mortar")
+    problem, ci = _blocks(comm, "mortar", order=order, basis=basis)
     problem.set_load_factor(1.0)
     rng = np.random.default_rng(7 + comm.rank)
     x = problem.solution_vector().copy()
@@ -172,7 +185,8 @@ def test_punch_rank_independent():
 
 
 @pytest.mark.parametrize("order,basis,match", [(1, "standard", "basis = 'standard'"),
-                                               (2, "dual", "displacement degree 2")])
+                                               (2, "dual", "displacement degree 2"),
+                                               (1, "dual_quadratic", "displacement degree 1")])
 def test_refused(order, basis, match):
     with pytest.raises(ValueError, match=match):
         _blocks(MPI.COMM_WORLD, "conforming", order=order, basis=basis)
