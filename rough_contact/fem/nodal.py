@@ -76,7 +76,6 @@ class NodalPoints:
         B: (n_v, 3, 3 m) rows of the weighted jump on the vertex's DOFs.
         nodes: (n_v, m) global block indices of those DOFs (padded with the first node).
         pad: (n_v, m) True for padding columns (B = 0 there).
-        fixed: (n_v, 3) the vertex's components fixed by a Dirichlet condition (mirrored).
         combination: the rows of T with ``basis="dual_quadratic"``, else None.
     """
 
@@ -88,7 +87,6 @@ class NodalPoints:
     B: np.ndarray
     nodes: np.ndarray
     pad: np.ndarray
-    fixed: Optional[np.ndarray] = None
     combination: Optional["RowCombination"] = None
 
 
@@ -409,7 +407,7 @@ def nodal_points(ctx: SurfaceContext, paired: PairedPoints, op: JumpOperator,
     B = np.einsum("vai,vikc->vakc", frames, A).reshape(n_v, 3, 3 * width) / m[:, None, None]
     j0 = np.einsum("vai,vi->va", frames, sums[:, 3:]) / m[:, None]
     return NodalPoints(vertex=verts, x=x, weights=m, frames=frames, jump0=j0, B=B,
-                       nodes=nodes, pad=pad, fixed=fixed, combination=combination)
+                       nodes=nodes, pad=pad, combination=combination)
 
 
 class VertexJumpOperator(JumpOperator):
