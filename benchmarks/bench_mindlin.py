@@ -3,7 +3,7 @@
     OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bench_mindlin.py [--levels 0.05 0.025]
         [--part stick|energy|all|mesh] [--amplitudes 0.5]
         [--ring 0.25 [--ring-band 0.8 1.05] [--ring-growth 0.1]]
-        [--exact --points nodal --basis dual] [--steps-per-cycle 16]
+        [--exact [--local-penalty] --points nodal --basis dual] [--steps-per-cycle 16]
         [--half-width 4 --height 4 --mesh-size 1 --transition 1]
 
 Rigid paraboloid R = 10 mm on a half block 8 x 4 x 4 mm, E = 200 GPa, nu = 0.49, mu = 0.3,
@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import argparse
 import time
+from dataclasses import replace
 
 import numpy as np
 from petsc4py import PETSc
@@ -164,8 +165,11 @@ def energy(levels, amplitudes, kt=None, kt_scale=None, ring_size=None, ring_band
            ring_growth=None, width_ratio=1e-3, augmented=False, quadrature_degree=None,
            verbose=False, steps_per_cycle=16, scene=None):
     """``scene``: further arguments of ``mindlin.run`` (block, mesh, points, enforcement).
-    ``ring_growth``: the ring's growth to the contact size, a fraction of Hertz's radius."""
+    ``ring_growth``: the ring's growth to the contact size, a fraction of Hertz's radius.
+    ``scene["local_penalty"]``: the enforcement's penalty scaled with the vertex spacing
+    (``reference_spacing`` = the level's size)."""
     scene = dict(scene or {})
+    local = scene.pop("local_penalty", False)
     PETSc.Sys.Print(f"{'h':>6} {'DOFs':>7} {'ampl':>5} {'Q*/muP':>6} {'W FE':>10} {'loop':>10} "
                     f"{'W MD':>10} {'error':>7} {'loop e':>7} {'trap':>7} {'Masing':>7} "
                     f"{'Newton':>6} {'time s':>6} "
@@ -174,6 +178,8 @@ def energy(levels, amplitudes, kt=None, kt_scale=None, ring_size=None, ring_band
     L, H = scene.get("half_width", 4.0), scene.get("height", 4.0)
     c_b = H / (G * 2.0 * L * L)         # the block's shear compliance [mm/N]
     for h in levels:
+        if local:
+            scene["enforcement"] = replace(scene["enforcement"], reference_spacing=h)
         for amp in amplitudes:
             t0, c0 = time.perf_counter(), time.process_time()
             r = mindlin.run(contact_size=h, order=2, nu=NU, mu=MU,
@@ -236,6 +242,11 @@ def main(argv=None):
                     help="energy: exact contact and stick by multipliers updated inside "
                     "Newton (NewtonAugmentedLagrangian(--al-tol); needs --points nodal)")
     ap.add_argument("--al-tol", type=float, default=1e-4)
+    ap.add_argument("--local-penalty", action="store_true",
+                    help="energy, with --exact: the penalties chosen for the level's size h "
+                    "scaled at each vertex by h / h_j (NewtonAugmentedLagrangian("
+                    "reference_spacing=h)): the ring's vertices get a stiffer penalty, fewer "
+                    "Newton iterations, the same fixed point")
     ap.add_argument("--half-width", type=float, default=4.0, help="block half width L [mm]")
     ap.add_argument("--height", type=float, default=4.0, help="block height H [mm]")
     ap.add_argument("--mesh-size", type=float, default=1.0, help="far element size [mm]")
@@ -258,6 +269,9 @@ def main(argv=None):
                      points=args.points, basis=args.basis)
         if args.exact:
             scene["enforcement"] = NewtonAugmentedLagrangian(args.al_tol, 60)
+        elif args.local_penalty:
+            ap.error("--local-penalty needs --exact")
+        scene["local_penalty"] = args.local_penalty
         energy(args.levels, args.amplitudes, args.k_tangential, args.kt_scale, args.ring,
                args.ring_band, args.ring_growth, args.width_ratio, args.augmented,
                args.quadrature_degree, args.verbose, args.steps_per_cycle, scene)

@@ -216,6 +216,14 @@ class ContactInterface(InterfaceQueries):
         self._anchor = self._start = None
         self._dirichlet = (None, list(bcs))
         self._set_operator(self._point_set(ctx, bcs))
+        if (isinstance(self.enforcement, AugmentedLagrangian)
+                and self.enforcement.reference_spacing is not None
+                and self.point_spacing is None):
+            raise ValueError(
+                f"enforcement {self.enforcement.name} with reference_spacing = "
+                f"{self.enforcement.reference_spacing!r} mm scales the penalty with each "
+                "point's spacing, which only the nodal point set knows: use "
+                "rough_contact.fem.nodal.NodalContactInterface, or reference_spacing=None")
         n = self.n_points
         self.history = InterfaceHistory(initial_law_state(law, n, self.comm),
                                         self.enforcement.initial_multipliers(n))
@@ -231,6 +239,13 @@ class ContactInterface(InterfaceQueries):
         """The jump operator at the points the law is evaluated at (collective); here the
         pairing's points themselves (``self.paired``)."""
         return JumpOperator(ctx.V, self.paired, bcs=bcs)
+
+    @property
+    def point_spacing(self) -> Optional[np.ndarray]:
+        """(n_pts,) each point's spacing [mm] where the point set defines one (the nodal
+        set's ``NodalPoints.spacing``), else None (quadrature points: a rule's points are not
+        spaced as the mesh is). Passed to the enforcement (``Enforcement.law_for``)."""
+        return None
 
     def _set_operator(self, operator: JumpOperator, jump0: Optional[np.ndarray] = None):
         self.operator = operator
@@ -354,7 +369,7 @@ class ContactInterface(InterfaceQueries):
 
     def _evaluating_law(self) -> InterfaceLawProtocol:
         law = self.law if self._softened is None else self._softened[1]
-        return self.enforcement.law_for(law, self.history.multipliers)
+        return self.enforcement.law_for(law, self.history.multipliers, self.point_spacing)
 
     @property
     def softenable(self) -> bool:

@@ -77,6 +77,13 @@ class NodalPoints:
         nodes: (n_v, m) global block indices of those DOFs (padded with the first node).
         pad: (n_v, m) True for padding columns (B = 0 there).
         combination: the rows of T with ``basis="dual_quadratic"``, else None.
+        spacing: (n_v,) h_j = sqrt(m_j / s) [mm], s = sqrt(3)/2 on a triangulated surface
+            and 1 on a quadrilateral one: the edge of the uniform mesh of equilateral
+            triangles (squares) whose vertices carry the weight m_j, i.e. the local point
+            spacing (with ``basis="dual_quadratic"`` the node spacing, about half the element
+            size). A point on a mirror plane or on the surface's edge carries a smaller
+            weight, so a smaller h_j. What ``AugmentedLagrangian(reference_spacing=)``
+            scales the penalty with.
     """
 
     vertex: np.ndarray
@@ -88,6 +95,7 @@ class NodalPoints:
     nodes: np.ndarray
     pad: np.ndarray
     combination: Optional["RowCombination"] = None
+    spacing: Optional[np.ndarray] = None
 
 
 @dataclass(frozen=True)
@@ -406,8 +414,10 @@ def nodal_points(ctx: SurfaceContext, paired: PairedPoints, op: JumpOperator,
     frames, _ = local_frames(comm, x, normal, ctx.grain)
     B = np.einsum("vai,vikc->vakc", frames, A).reshape(n_v, 3, 3 * width) / m[:, None, None]
     j0 = np.einsum("vai,vi->va", frames, sums[:, 3:]) / m[:, None]
+    shape = 1.0 if basix_cell(V.mesh) == basix.CellType.hexahedron else np.sqrt(3.0) / 2.0
     return NodalPoints(vertex=verts, x=x, weights=m, frames=frames, jump0=j0, B=B,
-                       nodes=nodes, pad=pad, combination=combination)
+                       nodes=nodes, pad=pad, combination=combination,
+                       spacing=np.sqrt(m / shape))
 
 
 class VertexJumpOperator(JumpOperator):
@@ -505,6 +515,11 @@ class NodalContactInterface(ContactInterface):
             frames=nodal.frames, jump0=nodal.jump0, N1=np.zeros((n_v, 1, 0)),
             nodes1=nodal.vertex[:, None], partners=None, name="nodal")
         return VertexJumpOperator(ctx.V, nodal, bcs=bcs)
+
+    @property
+    def point_spacing(self) -> np.ndarray:
+        """(n_v,) the vertex spacing h_j of :attr:`NodalPoints.spacing` [mm]."""
+        return self.nodal.spacing
 
     def updates_in_newton(self) -> bool:
         """Whether the enforcement updates the multipliers inside the Newton iteration

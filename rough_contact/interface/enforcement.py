@@ -68,9 +68,11 @@ class Enforcement(Protocol):
         """(n, 3) virgin multipliers, or None for a strategy without multipliers."""
         ...
 
-    def law_for(self, law: InterfaceLawProtocol,
-                multipliers: Optional[np.ndarray]) -> InterfaceLawProtocol:
-        """The law as this strategy evaluates it with the committed ``multipliers``."""
+    def law_for(self, law: InterfaceLawProtocol, multipliers: Optional[np.ndarray],
+                spacing: Optional[np.ndarray] = None) -> InterfaceLawProtocol:
+        """The law as this strategy evaluates it with the committed ``multipliers``;
+        ``spacing``: (n,) the points' spacing [mm] where the point set knows it (the nodal
+        one: :attr:`rough_contact.fem.nodal.NodalPoints.spacing`), else None."""
         ...
 
 
@@ -87,7 +89,8 @@ class Penalty:
         """No multipliers."""
         return None
 
-    def law_for(self, law: InterfaceLawProtocol, multipliers: None) -> InterfaceLawProtocol:
+    def law_for(self, law: InterfaceLawProtocol, multipliers: None,
+                spacing: Optional[np.ndarray] = None) -> InterfaceLawProtocol:
         """The law itself."""
         return law
 
@@ -119,17 +122,28 @@ class AugmentedLagrangian:
             default) for a penalty law whose stiffness the user chose (``SoftplusPenalty``);
             for the rough law, whose tangential stiffness K_T = c k_N is the physical and soft
             one, 10-100 (docs/exact_contact.md).
+        reference_spacing: the point spacing [mm] (> 0) the law's penalty was chosen for, or
+            None (the default: the same penalty at every point). Given, each point's penalty
+            is also multiplied by reference_spacing / h_j, h_j the point's own spacing
+            (nodal point set only, ``NodalPoints.spacing``). The stiffness K_b a point sees
+            from the bodies grows as E / h_j, so on a mesh graded towards a front (a ring of
+            small elements where the slip zone lies) a penalty chosen for the coarser spacing
+            is soft there and the updates crawl; scaled, the rate is the same everywhere
+            (docs/mindlin_dual.md measures it). The fixed point does not depend on it.
     """
 
     tolerance: float = 1e-3
     max_updates: int = 30
     stiffness_factor: float = 1.0
+    reference_spacing: Optional[float] = None
     name: str = "augmented_lagrangian"
 
     def __post_init__(self) -> None:
         check_scalar("augmentation tolerance", self.tolerance, lo=0.0, hi=1.0, hi_open=True)
         check_scalar("stiffness_factor", self.stiffness_factor, lo=0.0)
         check_integer("max_updates", self.max_updates, lo=1)
+        if self.reference_spacing is not None:
+            check_scalar("reference_spacing", self.reference_spacing, lo=0.0, unit="mm")
 
     def check_law(self, law: InterfaceLawProtocol) -> None:
         """The law must be a MultiplierLaw (its penalty can be shifted)."""
@@ -143,9 +157,24 @@ class AugmentedLagrangian:
         """Zero multipliers at n_points points."""
         return np.zeros((int(n_points), 3))
 
-    def law_for(self, law: MultiplierLaw, multipliers: np.ndarray) -> InterfaceLawProtocol:
-        """The law shifted by ``multipliers`` (its penalty times ``stiffness_factor``)."""
-        return law.with_multipliers(multipliers, self.stiffness_factor)
+    def law_for(self, law: MultiplierLaw, multipliers: np.ndarray,
+                spacing: Optional[np.ndarray] = None) -> InterfaceLawProtocol:
+        """The law shifted by ``multipliers``, its penalty times ``stiffness_factor`` and, with
+        ``reference_spacing``, times reference_spacing / h_j at each point (``spacing``: the
+        h_j, (n,) [mm]).
+
+        Raises:
+            ValueError: ``reference_spacing`` set and ``spacing`` None (a point set that does
+                not know its spacing) or not (n,).
+        """
+        if self.reference_spacing is None:
+            return law.with_multipliers(multipliers, self.stiffness_factor)
+        if spacing is None:
+            raise ValueError(f"reference_spacing = {self.reference_spacing!r} mm needs the "
+                             "points' spacing, which only the nodal point set knows "
+                             "(rough_contact.fem.nodal.NodalContactInterface)")
+        return law.with_multipliers(
+            multipliers, self.stiffness_factor * self.reference_spacing / np.asarray(spacing))
 
     @staticmethod
     def update(multipliers: np.ndarray, result: LawResult) -> MultiplierUpdate:
@@ -262,7 +291,8 @@ class SemismoothNewton:
         """No multipliers: the tractions are condensed."""
         return None
 
-    def law_for(self, law: InterfaceLawProtocol, multipliers: None) -> InterfaceLawProtocol:
+    def law_for(self, law: InterfaceLawProtocol, multipliers: None,
+                spacing: Optional[np.ndarray] = None) -> InterfaceLawProtocol:
         """The law itself (not evaluated for the residual)."""
         return law
 

@@ -24,7 +24,7 @@ from typing import Optional, Protocol, Tuple, Union, runtime_checkable
 import numpy as np
 
 from ..validation import check_scalar
-from .contract import InterfaceLawProtocol, LawResult, check_jump
+from .contract import InterfaceLawProtocol, LawResult, check_jump, check_stiffness_factor
 from .friction import (FrictionInput, IsotropicSlipHardening, OrthotropicSlipHardening,
                        ShiftedFrictionInput)
 from .history import HistoryNormalLawProtocol, ReversalStiffnessProtocol
@@ -189,14 +189,15 @@ class InterfaceLaw:
         return np.asarray(self.normal.normal_dissipation(state.h_min), dtype=float)
 
     def with_multipliers(self, multipliers: np.ndarray,
-                         stiffness_factor: float = 1.0) -> InterfaceLawProtocol:
+                         stiffness_factor=1.0) -> InterfaceLawProtocol:
         """The law with its friction trial traction shifted by the tangential multipliers
         (``rough_contact.interface.contract.MultiplierLaw``; see the class).
 
         Args:
             multipliers: (n, 3) [lambda_N, lambda_x, lambda_y] [MPa], finite, lambda_N >= 0
                 (lambda_N is not used: the normal law stays the unshifted p(h)).
-            stiffness_factor: (> 0) the shifted law's tangential stiffness is factor x K_T:
+            stiffness_factor: (> 0, a number or one per point, (n,)) the shifted law's
+                tangential stiffness is factor x K_T:
                 t_trial = lambda_T + factor K_T(h) (s - s_p). The fixed point (s = s_p at
                 sticking points) does not depend on it; the updates converge by about
                 K_b / (K_b + factor K_T) each (K_b: the stiffness a point sees from the
@@ -211,7 +212,7 @@ class InterfaceLaw:
             ValueError: ``multipliers`` not (n, 3), not finite, or lambda_N < 0.
         """
         lam = _check_multipliers(multipliers)
-        f = check_scalar("stiffness_factor", stiffness_factor, lo=0.0)
+        f = check_stiffness_factor(stiffness_factor, lam.shape[0])
         if self.friction is None:
             return self
         return ShiftedInterfaceLaw(self, lam, f)
@@ -234,7 +235,7 @@ class InterfaceLaw:
         return self._evaluate(jump, committed, None)
 
     def _evaluate(self, jump: np.ndarray, committed: InterfaceState,
-                  shift: Optional[np.ndarray], stiffness_factor: float = 1.0) -> LawResult:
+                  shift: Optional[np.ndarray], stiffness_factor=1.0) -> LawResult:
         """``evaluate`` with the friction trial traction shifted by ``shift`` (n, 2) [MPa]
         (None: the plain law) and the tangential stiffness multiplied by ``stiffness_factor``
         (only with a shift)."""
@@ -290,7 +291,7 @@ class InterfaceLaw:
                              slipping, beyond, normal_dissipation)
 
         cx, cy = self.tangential.kt_over_kn
-        if shift is not None and stiffness_factor != 1.0:
+        if shift is not None and np.ndim(stiffness_factor) == 0 and stiffness_factor != 1.0:
             cx, cy = cx * stiffness_factor, cy * stiffness_factor
         sp = committed.plastic_slip
         kap = committed.accumulated_slip
@@ -304,6 +305,8 @@ class InterfaceLaw:
                 kt, dkt = k.copy(), dk.copy()
                 kt[un] *= scale
                 dkt[un] *= scale
+        if shift is not None and np.ndim(stiffness_factor):     # one factor per point
+            kt, dkt = kt * stiffness_factor, dkt * stiffness_factor     # new arrays
         if contact.all():  # work on views: no gather/scatter
             cols = (jump[:, 1] - sp[:, 0], jump[:, 2] - sp[:, 1], cx * kt, cy * kt, cx * dkt,
                     cy * dkt, p, k, kap[:, 0], kap[:, 1], committed.slip_path)
@@ -373,12 +376,13 @@ class ShiftedInterfaceLaw:
         law: the plain law (with friction).
         multipliers: (n, 3) [lambda_N, lambda_x, lambda_y] [MPa], checked by
             ``with_multipliers``.
-        stiffness_factor: the shifted law's K_T is this times the law's (> 0).
+        stiffness_factor: the shifted law's K_T is this times the law's (> 0; a number or one
+            per point, (n,)).
     """
 
     law: InterfaceLaw
     multipliers: np.ndarray
-    stiffness_factor: float = 1.0
+    stiffness_factor: Union[float, np.ndarray] = 1.0
 
     def initial_state(self, n_pts: int) -> InterfaceState:
         """Virgin history at n_pts points (that of the plain law)."""

@@ -18,7 +18,7 @@ import numpy as np
 from scipy.special import expit
 
 from ..validation import check_scalar
-from .contract import CoulombLimit, LawResult, check_jump
+from .contract import CoulombLimit, LawResult, check_jump, check_stiffness_factor
 from .state import InterfaceState
 
 __all__ = ["LinearPenalty", "SoftplusPenalty", "ShiftedSoftplusPenalty"]
@@ -150,12 +150,15 @@ class SoftplusPenalty:
         return InterfaceState.zeros(n_pts)
 
     def with_multipliers(self, multipliers: np.ndarray,
-                         stiffness_factor: float = 1.0) -> ShiftedSoftplusPenalty:
+                         stiffness_factor=1.0) -> ShiftedSoftplusPenalty:
         """The law with its penalty shifted by ``multipliers`` (n, 3) [MPa]
         (``rough_contact.interface.contract.MultiplierLaw``); ``stiffness_factor`` != 1: the
         shifted law has k_N and k_T multiplied by it and the width divided by it (p(0) kept),
-        as :meth:`softened` with 1 / factor."""
-        f = check_scalar("stiffness_factor", stiffness_factor, lo=0.0)
+        as :meth:`softened` with 1 / factor. The factor is a number or one per point, (n,)
+        (a per-point penalty, e.g. scaled with the local point spacing)."""
+        f = check_stiffness_factor(stiffness_factor, np.shape(multipliers)[0])
+        if isinstance(f, np.ndarray):
+            return ShiftedSoftplusPenalty(self, multipliers, f)
         law = self if f == 1.0 else replace(self, k_normal=self.k_normal * f,
                                             width=self.width / f,
                                             k_tangential=self.k_tangential * f)
@@ -170,18 +173,27 @@ class SoftplusPenalty:
         return replace(self, k_normal=self.k_normal / f, width=self.width * f,
                        k_tangential=self.k_tangential / f)
 
-    def _shifts(self, multipliers: Optional[np.ndarray]):
+    def _penalties(self, factor: Optional[np.ndarray]):
+        """(k_N, w, k_T): the law's numbers (factor None) or per point, (n,) arrays, with k_N
+        and k_T multiplied by ``factor`` and w divided by it (p(0) kept)."""
+        if factor is None:
+            return self.k_normal, self.width, self.k_tangential
+        return self.k_normal * factor, self.width / factor, self.k_tangential * factor
+
+    @staticmethod
+    def _shifts(multipliers: Optional[np.ndarray], kn):
         """(gap shift lambda_N / k_N (n,) [mm], tangential multiplier (n, 2) [MPa]); the scalar
         0.0 for both without multipliers."""
         if multipliers is None:
             return 0.0, 0.0
         lam = np.asarray(multipliers)
-        return lam[:, 0] / self.k_normal, lam[:, 1:]
+        return lam[:, 0] / kn, lam[:, 1:]
 
-    def _trial_traction(self, jump: np.ndarray, committed: InterfaceState,
-                        lam_t) -> np.ndarray:
-        """Elastic predictor tau = lambda_T + k_T (s - s_p) (n, 2) [MPa]."""
-        return lam_t + self.k_tangential * (jump[:, 1:] - committed.plastic_slip)
+    @staticmethod
+    def _trial_traction(jump: np.ndarray, committed: InterfaceState, lam_t, kt) -> np.ndarray:
+        """Elastic predictor tau = lambda_T + k_T (s - s_p) (n, 2) [MPa] (k_T a number or
+        (n,))."""
+        return lam_t + np.reshape(kt, (-1, 1)) * (jump[:, 1:] - committed.plastic_slip)
 
     def coulomb_limit(self) -> CoulombLimit:
         """Signorini contact with Coulomb's mu (0 without tangential stiffness) and this law's
@@ -196,13 +208,21 @@ class SoftplusPenalty:
 
     def normal(self, g: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Pressure p(g) [MPa] and stiffness k = -dp/dg [MPa/mm] at gaps g (n,) [mm]."""
-        z = -np.asarray(g, dtype=float) / self.width
-        return self.k_normal * self.width * np.logaddexp(0.0, z), self.k_normal * expit(z)
+        return self._normal(g, self.k_normal, self.width)
+
+    @staticmethod
+    def _normal(g, kn, w) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`normal` with the penalty k_N and width w given (numbers or (n,))."""
+        z = -np.asarray(g, dtype=float) / w
+        return kn * w * np.logaddexp(0.0, z), kn * expit(z)
 
     def evaluate(self, jump: np.ndarray, committed: InterfaceState,
-                 multipliers: Optional[np.ndarray] = None) -> LawResult:
+                 multipliers: Optional[np.ndarray] = None,
+                 factor: Optional[np.ndarray] = None) -> LawResult:
         """Traction (n, 3) and tangent (n, 3, 3) at jump (n, 3) [mm]; pure (no mutation).
         ``multipliers`` (n, 3) shift the penalty (see the class; None: the plain penalty).
+        ``factor`` (n,) > 0: per-point penalties, k_N and k_T times it and w divided by it
+        (None: the law's; checked by :meth:`with_multipliers`).
 
         The trial state carries the plastic slip and, for the record, the slip magnitudes
         (``accumulated_slip``, ``slip_path``); Coulomb friction does not harden.
@@ -215,8 +235,9 @@ class SoftplusPenalty:
         if multipliers is not None and np.shape(multipliers) != (n, 3):
             raise ValueError(f"multipliers of shape {np.shape(multipliers)} for {n} points; "
                              f"expected ({n}, 3)")
-        shift, lam_t = self._shifts(multipliers)
-        p, k = self.normal(jump[:, 0] - shift)
+        kn, w, kt = self._penalties(factor)
+        shift, lam_t = self._shifts(multipliers, kn)
+        p, k = self._normal(jump[:, 0] - shift, kn, w)
         traction = np.zeros((n, 3))
         tangent = np.zeros((n, 3, 3))
         traction[:, 0] = -p
@@ -225,8 +246,8 @@ class SoftplusPenalty:
         dissipation = np.zeros(n)
         slipping = np.zeros(n, dtype=bool)
         if self.k_tangential > 0.0:
-            kt = self.k_tangential
-            tau = self._trial_traction(jump, committed, lam_t)
+            kt = np.broadcast_to(kt, (n,))
+            tau = self._trial_traction(jump, committed, lam_t, kt)
             norm = np.linalg.norm(tau, axis=1)
             limit = self.friction * p
             # a relative margin keeps points exactly on the cone (e.g. re-evaluated after a
@@ -234,22 +255,23 @@ class SoftplusPenalty:
             ret = norm > limit * (1.0 + 1e-12)      # radial return (also where p = 0)
             stick = ~ret
             traction[stick, 1:] = tau[stick]
-            tangent[stick, 1, 1] = kt
-            tangent[stick, 2, 2] = kt
+            tangent[stick, 1, 1] = kt[stick]
+            tangent[stick, 2, 2] = kt[stick]
             if np.any(ret):
                 ns = norm[ret]
                 m = tau[ret] / ns[:, None]
                 ls = limit[ret]
                 traction[ret, 1:] = ls[:, None] * m
-                ratio = ls * kt / ns
+                ktr = kt[ret]
+                ratio = ls * ktr / ns
                 tangent[ret, 1:, 1:] = ratio[:, None, None] * (
                     np.eye(2)[None] - m[:, :, None] * m[:, None, :]
                 )
                 tangent[ret, 1:, 0] = -self.friction * k[ret][:, None] * m
-                dslip = ((ns - ls) / kt)[:, None] * m
+                dslip = ((ns - ls) / ktr)[:, None] * m
                 state.plastic_slip[ret] += dslip
                 state.accumulated_slip[ret] += np.abs(dslip)
-                state.slip_path[ret] += (ns - ls) / kt
+                state.slip_path[ret] += (ns - ls) / ktr
                 dissipation[ret] = np.einsum("ij,ij->i", traction[ret, 1:], dslip)
             # a point out of contact (p = 0: zero limit, zero traction) follows the other
             # surface freely; it is open, not slipping (the counters count slip in contact)
@@ -259,14 +281,15 @@ class SoftplusPenalty:
             tangent=tangent,
             state=state,
             dissipation=dissipation,
-            area_fraction=expit(-(jump[:, 0] - shift) / self.width),
+            area_fraction=expit(-(jump[:, 0] - shift) / w),
             contact=p > 0.0,
             slipping=slipping,
         )
 
     def newton_tangent(self, jump: np.ndarray, committed: InterfaceState, result: LawResult,
                        previous: Optional[np.ndarray],
-                       multipliers: Optional[np.ndarray] = None
+                       multipliers: Optional[np.ndarray] = None,
+                       factor: Optional[np.ndarray] = None
                        ) -> tuple[np.ndarray, np.ndarray]:
         """Tangent for a Newton step at ``jump`` (pure; the residual is not affected).
 
@@ -282,11 +305,14 @@ class SoftplusPenalty:
             stiffness ``reversal_stiffness`` k_T |t_T| / |tau| added along m = tau / |tau| at
             slipping points whose trial direction reversed since ``previous`` (see the
             class); memo = (n, 2) trial directions m, to pass as ``previous`` next time.
-            ``multipliers``: those ``result`` was computed with (None: plain penalty).
+            ``multipliers``, ``factor``: those ``result`` was computed with (None: plain
+            penalty; the law's own penalties).
         """
         if self.k_tangential <= 0.0:
             return result.tangent, None
-        tau = self._trial_traction(jump, committed, self._shifts(multipliers)[1])
+        kn, _, kt = self._penalties(factor)
+        kt = np.broadcast_to(kt, (jump.shape[0],))
+        tau = self._trial_traction(jump, committed, self._shifts(multipliers, kn)[1], kt)
         norm = np.linalg.norm(tau, axis=1)
         m = np.divide(tau, norm[:, None], out=np.zeros_like(tau), where=norm[:, None] > 0.0)
         tangent = result.tangent
@@ -296,7 +322,7 @@ class SoftplusPenalty:
             if np.any(flip):
                 tangent = tangent.copy()
                 mf = m[flip]
-                secant = (self.reversal_stiffness * self.k_tangential
+                secant = (self.reversal_stiffness * kt[flip]
                           * np.linalg.norm(result.traction[flip, 1:], axis=1) / norm[flip])
                 tangent[flip, 1:, 1:] += secant[:, None, None] * mf[:, :, None] * mf[:, None, :]
         return tangent, m
@@ -305,10 +331,12 @@ class SoftplusPenalty:
 @dataclass(frozen=True)
 class ShiftedSoftplusPenalty:
     """A :class:`SoftplusPenalty` with its penalty shifted by multipliers (n, 3) [MPa]: what
-    ``SoftplusPenalty.with_multipliers`` returns for one evaluation of n points."""
+    ``SoftplusPenalty.with_multipliers`` returns for one evaluation of n points; ``factor``
+    (n,): per-point penalties (k_N, k_T times it, w divided by it; None: the law's)."""
 
     law: SoftplusPenalty
     multipliers: np.ndarray
+    factor: Optional[np.ndarray] = None
 
     def initial_state(self, n_pts: int) -> InterfaceState:
         """Virgin history at n_pts points (that of the plain law)."""
@@ -316,11 +344,12 @@ class ShiftedSoftplusPenalty:
 
     def evaluate(self, jump: np.ndarray, committed: InterfaceState) -> LawResult:
         """The shifted law at ``jump`` (see :meth:`SoftplusPenalty.evaluate`)."""
-        return self.law.evaluate(jump, committed, self.multipliers)
+        return self.law.evaluate(jump, committed, self.multipliers, self.factor)
 
     def newton_tangent(self, jump, committed, result, previous):
         """See :meth:`SoftplusPenalty.newton_tangent`."""
-        return self.law.newton_tangent(jump, committed, result, previous, self.multipliers)
+        return self.law.newton_tangent(jump, committed, result, previous, self.multipliers,
+                                       self.factor)
 
     def max_friction_coefficient(self) -> float:
         """That of the plain law."""

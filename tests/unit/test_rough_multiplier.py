@@ -409,3 +409,30 @@ def test_stiffness_factor_is_the_law_with_a_stiffer_kt(regime):
     frac = r.slipping[keep].mean()
     assert {"stick": frac == 0.0, "slip": frac > 0.97, "mixed": 0.1 < frac < 0.9}[regime], frac
     fd_check(shifted, jump, st, keep)
+
+
+def test_per_point_stiffness_factor_is_each_point_with_its_own_kt():
+    """A stiffness factor per point: each point evaluates as the law with that point's factor
+    given as a number (the factor moves from c to the stiffness, a different product order,
+    hence 1e-12 and not bit equality); its tangent matches central differences."""
+    law = InterfaceLaw(ExponentialNormal(), TS, ORTHO, h0=1e-3)
+    rng = np.random.default_rng(12)
+    n = 300
+    st = random_state(rng, n)
+    jump = np.column_stack([rng.uniform(-1e-3, 1e-3, n),
+                            st.plastic_slip + rng.normal(size=(n, 2)) * 3e-5])
+    lam = multipliers_for(law, jump, rng, 1.2)
+    values = np.array([1.0, 4.0, 30.0])
+    f = values[rng.integers(0, 3, n)]
+    shifted = law.with_multipliers(lam, f)
+    r = shifted.evaluate(jump, st)
+    for v in values:
+        i = np.flatnonzero(f == v)
+        sub = InterfaceState(st.plastic_slip[i], st.accumulated_slip[i], st.slip_path[i])
+        ref = law.with_multipliers(lam[i], v).evaluate(jump[i], sub)
+        np.testing.assert_allclose(r.traction[i], ref.traction, rtol=1e-12, atol=1e-15)
+        np.testing.assert_allclose(r.tangent[i], ref.tangent, rtol=1e-12, atol=1e-9)
+        np.testing.assert_array_equal(r.slipping[i], ref.slipping)
+    assert 0.1 < r.slipping[r.contact].mean() < 0.9
+    keep = np.abs(trial_ratio(law, jump, st, lam[:, 1:]) - 1.0) > 1e-4
+    fd_check(shifted, jump, st, keep)
