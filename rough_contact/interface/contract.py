@@ -73,7 +73,7 @@ import numpy as np
 __all__ = ["ConvergenceError", "LawState", "LawResult", "InterfaceLawProtocol",
            "CoulombLimit", "CoulombContactLaw",
            "FrictionBoundedLaw", "NewtonTangentLaw", "MultiplierLaw", "SoftenableLaw",
-           "LawContractError", "check_jump", "check_stiffness_factor"]
+           "LawContractError", "check_jump", "check_point_factor"]
 
 
 class ConvergenceError(ArithmeticError):
@@ -244,15 +244,19 @@ class MultiplierLaw(Protocol):
     history, not by the law state: a law with this capability is still an ordinary law (its
     ``evaluate`` is the unshifted penalty)."""
 
-    def with_multipliers(self, multipliers: np.ndarray,
-                         stiffness_factor=1.0) -> InterfaceLawProtocol:
+    def with_multipliers(self, multipliers: np.ndarray, stiffness_factor: float = 1.0,
+                         tangential_factor: Optional[np.ndarray] = None
+                         ) -> InterfaceLawProtocol:
         """The law with its penalty shifted by ``multipliers`` (n, 3) [MPa], and the penalty the
         multipliers are augmented with multiplied by ``stiffness_factor`` (> 0; 1: the law's
         own; the fixed point does not depend on it, the rate of the updates does: about
         K_b / (K_b + factor x penalty) per update, K_b the stiffness a point sees from the
-        bodies). The factor is a number or an (n,) array, one per point
-        (:func:`check_stiffness_factor`): K_b grows as the points get closer, so a mesh graded
-        towards a front needs a penalty that grows with it. Returns an object with the
+        bodies). ``tangential_factor`` (n,) > 0 (:func:`check_point_factor`), or None: each
+        point's tangential penalty multiplied by its own factor besides: K_b grows as the
+        points get closer, so a mesh graded towards a front needs a tangential penalty that
+        grows with it. It only scales the tangential penalty, whose fixed point (s = s_p where
+        a point sticks, |t| = mu p where it slips) does not depend on it; a smoothed normal
+        penalty's fixed point does depend on its own stiffness. Returns an object with the
         same ``initial_state``/``evaluate`` (and ``newton_tangent``, if the law has one) for
         those n points; cheap to create (no copy of the arrays)."""
         ...
@@ -333,29 +337,24 @@ def check_jump(jump, committed: LawState) -> np.ndarray:
     return jump
 
 
-def check_stiffness_factor(factor, n: int):
-    """A ``with_multipliers`` stiffness factor: a finite number > 0 (returned as a float) or
-    one per point, a finite (n,) array > 0 (returned as a float array).
+def check_point_factor(name: str, factor, n: int) -> np.ndarray:
+    """A per-point factor (e.g. ``with_multipliers``' ``tangential_factor``): a finite (n,)
+    array > 0, returned as a float array.
 
     Raises:
-        ValueError: naming the shape or the first bad value and the valid range.
+        ValueError: naming ``name``, the shape or the first bad value, and the valid range.
     """
-    if np.ndim(factor) == 0:
-        if isinstance(factor, (str, bytes)):
-            raise ValueError(f"stiffness_factor = {factor!r} is invalid: it must be a number "
-                             "> 0 or an (n,) array of them")
-        f = float(factor)
-        if not (np.isfinite(f) and f > 0.0):
-            raise ValueError(f"stiffness_factor = {factor!r} is invalid: it must be finite "
-                             "and > 0")
-        return f
-    f = np.asarray(factor, dtype=float)
+    try:
+        f = np.asarray(factor, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} ({type(factor).__name__}) is invalid: it must be an ({n},) "
+                         "array of numbers > 0") from None
     if f.shape != (n,):
-        raise ValueError(f"stiffness_factor of shape {f.shape} for {n} points is invalid: "
-                         f"a number or one per point, ({n},)")
+        raise ValueError(f"{name} of shape {f.shape} for {n} points is invalid: one factor "
+                         f"per point, ({n},)")
     bad = ~(np.isfinite(f) & (f > 0.0))
     if bad.any():
         i = int(np.flatnonzero(bad)[0])
-        raise ValueError(f"stiffness_factor[{i}] = {f[i]!r} is invalid ({int(bad.sum())} of "
-                         f"{n} points): it must be finite and > 0")
+        raise ValueError(f"{name}[{i}] = {f[i]!r} is invalid ({int(bad.sum())} of {n} "
+                         f"points): it must be finite and > 0")
     return f

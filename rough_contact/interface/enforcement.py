@@ -122,14 +122,16 @@ class AugmentedLagrangian:
             default) for a penalty law whose stiffness the user chose (``SoftplusPenalty``);
             for the rough law, whose tangential stiffness K_T = c k_N is the physical and soft
             one, 10-100 (docs/exact_contact.md).
-        reference_spacing: the point spacing [mm] (> 0) the law's penalty was chosen for, or
-            None (the default: the same penalty at every point). Given, each point's penalty
-            is also multiplied by reference_spacing / h_j, h_j the point's own spacing
-            (nodal point set only, ``NodalPoints.spacing``). The stiffness K_b a point sees
-            from the bodies grows as E / h_j, so on a mesh graded towards a front (a ring of
-            small elements where the slip zone lies) a penalty chosen for the coarser spacing
-            is soft there and the updates crawl; scaled, the rate is the same everywhere
-            (docs/mindlin_dual.md measures it). The fixed point does not depend on it.
+        reference_spacing: the point spacing [mm] (> 0) the law's tangential penalty was
+            chosen for, or None (the default: the same penalty at every point). Given, each
+            point's tangential penalty is also multiplied by reference_spacing / h_j, h_j the
+            point's own spacing (nodal point set only, ``NodalPoints.spacing``). The stiffness
+            K_b a point sees from the bodies grows as E / h_j, so on a mesh graded towards a
+            front (a ring of small elements where the slip zone lies) a penalty chosen for the
+            coarser spacing is soft there and the stick multipliers crawl; scaled, the rate is
+            the same everywhere (docs/mindlin_dual.md measures it). The tangential fixed point
+            does not depend on it. The normal penalty is left alone: a smoothed one
+            (``SoftplusPenalty``'s width) is part of the answer at the contact's edge.
     """
 
     tolerance: float = 1e-3
@@ -160,8 +162,8 @@ class AugmentedLagrangian:
     def law_for(self, law: MultiplierLaw, multipliers: np.ndarray,
                 spacing: Optional[np.ndarray] = None) -> InterfaceLawProtocol:
         """The law shifted by ``multipliers``, its penalty times ``stiffness_factor`` and, with
-        ``reference_spacing``, times reference_spacing / h_j at each point (``spacing``: the
-        h_j, (n,) [mm]).
+        ``reference_spacing``, its tangential penalty times reference_spacing / h_j at each
+        point besides (``spacing``: the h_j, (n,) [mm]).
 
         Raises:
             ValueError: ``reference_spacing`` set and ``spacing`` None (a point set that does
@@ -173,8 +175,8 @@ class AugmentedLagrangian:
             raise ValueError(f"reference_spacing = {self.reference_spacing!r} mm needs the "
                              "points' spacing, which only the nodal point set knows "
                              "(rough_contact.fem.nodal.NodalContactInterface)")
-        return law.with_multipliers(
-            multipliers, self.stiffness_factor * self.reference_spacing / np.asarray(spacing))
+        return law.with_multipliers(multipliers, self.stiffness_factor,
+                                    self.reference_spacing / np.asarray(spacing))
 
     @staticmethod
     def update(multipliers: np.ndarray, result: LawResult) -> MultiplierUpdate:

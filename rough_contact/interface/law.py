@@ -24,7 +24,7 @@ from typing import Optional, Protocol, Tuple, Union, runtime_checkable
 import numpy as np
 
 from ..validation import check_scalar
-from .contract import InterfaceLawProtocol, LawResult, check_jump, check_stiffness_factor
+from .contract import InterfaceLawProtocol, LawResult, check_jump, check_point_factor
 from .friction import (FrictionInput, IsotropicSlipHardening, OrthotropicSlipHardening,
                        ShiftedFrictionInput)
 from .history import HistoryNormalLawProtocol, ReversalStiffnessProtocol
@@ -188,21 +188,23 @@ class InterfaceLaw:
             return np.zeros(len(state))
         return np.asarray(self.normal.normal_dissipation(state.h_min), dtype=float)
 
-    def with_multipliers(self, multipliers: np.ndarray,
-                         stiffness_factor=1.0) -> InterfaceLawProtocol:
+    def with_multipliers(self, multipliers: np.ndarray, stiffness_factor: float = 1.0,
+                         tangential_factor: Optional[np.ndarray] = None
+                         ) -> InterfaceLawProtocol:
         """The law with its friction trial traction shifted by the tangential multipliers
         (``rough_contact.interface.contract.MultiplierLaw``; see the class).
 
         Args:
             multipliers: (n, 3) [lambda_N, lambda_x, lambda_y] [MPa], finite, lambda_N >= 0
                 (lambda_N is not used: the normal law stays the unshifted p(h)).
-            stiffness_factor: (> 0, a number or one per point, (n,)) the shifted law's
-                tangential stiffness is factor x K_T:
+            stiffness_factor: (> 0) the shifted law's tangential stiffness is factor x K_T:
                 t_trial = lambda_T + factor K_T(h) (s - s_p). The fixed point (s = s_p at
                 sticking points) does not depend on it; the updates converge by about
                 K_b / (K_b + factor K_T) each (K_b: the stiffness a point sees from the
                 bodies), and the rough law's K_T is soft: 10-100 is the useful range
                 (docs/exact_contact.md). The normal law is never scaled.
+            tangential_factor: (n,) > 0 or None: each point's K_T multiplied by its own
+                factor besides (``MultiplierLaw.with_multipliers``).
 
         Returns:
             A :class:`ShiftedInterfaceLaw` for those n points; the law itself when it is
@@ -212,10 +214,12 @@ class InterfaceLaw:
             ValueError: ``multipliers`` not (n, 3), not finite, or lambda_N < 0.
         """
         lam = _check_multipliers(multipliers)
-        f = check_stiffness_factor(stiffness_factor, lam.shape[0])
+        f = check_scalar("stiffness_factor", stiffness_factor, lo=0.0)
+        tf = None if tangential_factor is None else \
+            check_point_factor("tangential_factor", tangential_factor, lam.shape[0])
         if self.friction is None:
             return self
-        return ShiftedInterfaceLaw(self, lam, f)
+        return ShiftedInterfaceLaw(self, lam, f, tf)
 
     def evaluate(self, jump: np.ndarray, committed: InterfaceState) -> LawResult:
         """Traction, consistent tangent and trial state at jump (n, 3) [mm]; never mutates input.
@@ -235,10 +239,11 @@ class InterfaceLaw:
         return self._evaluate(jump, committed, None)
 
     def _evaluate(self, jump: np.ndarray, committed: InterfaceState,
-                  shift: Optional[np.ndarray], stiffness_factor=1.0) -> LawResult:
+                  shift: Optional[np.ndarray], stiffness_factor: float = 1.0,
+                  tangential_factor: Optional[np.ndarray] = None) -> LawResult:
         """``evaluate`` with the friction trial traction shifted by ``shift`` (n, 2) [MPa]
         (None: the plain law) and the tangential stiffness multiplied by ``stiffness_factor``
-        (only with a shift)."""
+        and by ``tangential_factor`` (n,) (only with a shift)."""
         if self.h0 is None:
             raise ValueError("h0 (reference separation [mm]) is not set: pass h0= or use "
                              "with_seating(p_seat)")
@@ -291,7 +296,7 @@ class InterfaceLaw:
                              slipping, beyond, normal_dissipation)
 
         cx, cy = self.tangential.kt_over_kn
-        if shift is not None and np.ndim(stiffness_factor) == 0 and stiffness_factor != 1.0:
+        if shift is not None and stiffness_factor != 1.0:
             cx, cy = cx * stiffness_factor, cy * stiffness_factor
         sp = committed.plastic_slip
         kap = committed.accumulated_slip
@@ -305,8 +310,8 @@ class InterfaceLaw:
                 kt, dkt = k.copy(), dk.copy()
                 kt[un] *= scale
                 dkt[un] *= scale
-        if shift is not None and np.ndim(stiffness_factor):     # one factor per point
-            kt, dkt = kt * stiffness_factor, dkt * stiffness_factor     # new arrays
+        if shift is not None and tangential_factor is not None:     # one factor per point
+            kt, dkt = kt * tangential_factor, dkt * tangential_factor   # new arrays
         if contact.all():  # work on views: no gather/scatter
             cols = (jump[:, 1] - sp[:, 0], jump[:, 2] - sp[:, 1], cx * kt, cy * kt, cx * dkt,
                     cy * dkt, p, k, kap[:, 0], kap[:, 1], committed.slip_path)
@@ -376,13 +381,14 @@ class ShiftedInterfaceLaw:
         law: the plain law (with friction).
         multipliers: (n, 3) [lambda_N, lambda_x, lambda_y] [MPa], checked by
             ``with_multipliers``.
-        stiffness_factor: the shifted law's K_T is this times the law's (> 0; a number or one
-            per point, (n,)).
+        stiffness_factor: the shifted law's K_T is this times the law's (> 0).
+        tangential_factor: (n,) each point's K_T times it besides, or None.
     """
 
     law: InterfaceLaw
     multipliers: np.ndarray
-    stiffness_factor: Union[float, np.ndarray] = 1.0
+    stiffness_factor: float = 1.0
+    tangential_factor: Optional[np.ndarray] = None
 
     def initial_state(self, n_pts: int) -> InterfaceState:
         """Virgin history at n_pts points (that of the plain law)."""
@@ -392,7 +398,7 @@ class ShiftedInterfaceLaw:
         """The law at ``jump`` (n, 3) with t_trial = lambda_T + K_T (s - s_p) (see
         :meth:`InterfaceLaw.evaluate`; ValueError if the multipliers are not for n points)."""
         return self.law._evaluate(jump, committed, self.multipliers[:, 1:],
-                                  self.stiffness_factor)
+                                  self.stiffness_factor, self.tangential_factor)
 
     def max_friction_coefficient(self) -> float:
         """That of the plain law."""

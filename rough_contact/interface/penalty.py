@@ -18,7 +18,7 @@ import numpy as np
 from scipy.special import expit
 
 from ..validation import check_scalar
-from .contract import CoulombLimit, LawResult, check_jump, check_stiffness_factor
+from .contract import CoulombLimit, LawResult, check_jump, check_point_factor
 from .state import InterfaceState
 
 __all__ = ["LinearPenalty", "SoftplusPenalty", "ShiftedSoftplusPenalty"]
@@ -149,20 +149,22 @@ class SoftplusPenalty:
         """Virgin history (no plastic slip) at n_pts points."""
         return InterfaceState.zeros(n_pts)
 
-    def with_multipliers(self, multipliers: np.ndarray,
-                         stiffness_factor=1.0) -> ShiftedSoftplusPenalty:
+    def with_multipliers(self, multipliers: np.ndarray, stiffness_factor: float = 1.0,
+                         tangential_factor: Optional[np.ndarray] = None
+                         ) -> ShiftedSoftplusPenalty:
         """The law with its penalty shifted by ``multipliers`` (n, 3) [MPa]
         (``rough_contact.interface.contract.MultiplierLaw``); ``stiffness_factor`` != 1: the
         shifted law has k_N and k_T multiplied by it and the width divided by it (p(0) kept),
-        as :meth:`softened` with 1 / factor. The factor is a number or one per point, (n,)
-        (a per-point penalty, e.g. scaled with the local point spacing)."""
-        f = check_stiffness_factor(stiffness_factor, np.shape(multipliers)[0])
-        if isinstance(f, np.ndarray):
-            return ShiftedSoftplusPenalty(self, multipliers, f)
+        as :meth:`softened` with 1 / factor; ``tangential_factor`` (n,): each point's k_T
+        multiplied by its own factor besides (the normal law, whose smoothing is part of the
+        answer, is not touched)."""
+        f = check_scalar("stiffness_factor", stiffness_factor, lo=0.0)
+        tf = None if tangential_factor is None else \
+            check_point_factor("tangential_factor", tangential_factor, np.shape(multipliers)[0])
         law = self if f == 1.0 else replace(self, k_normal=self.k_normal * f,
                                             width=self.width / f,
                                             k_tangential=self.k_tangential * f)
-        return ShiftedSoftplusPenalty(law, multipliers)
+        return ShiftedSoftplusPenalty(law, multipliers, tf)
 
     def softened(self, factor: float) -> SoftplusPenalty:
         """The law with k_N and k_T divided by ``factor`` >= 1 and the width multiplied by it
@@ -173,27 +175,24 @@ class SoftplusPenalty:
         return replace(self, k_normal=self.k_normal / f, width=self.width * f,
                        k_tangential=self.k_tangential / f)
 
-    def _penalties(self, factor: Optional[np.ndarray]):
-        """(k_N, w, k_T): the law's numbers (factor None) or per point, (n,) arrays, with k_N
-        and k_T multiplied by ``factor`` and w divided by it (p(0) kept)."""
+    def _kt(self, n: int, factor: Optional[np.ndarray]) -> np.ndarray:
+        """(n,) k_T at each point: the law's, times ``factor`` (n,) where given."""
         if factor is None:
-            return self.k_normal, self.width, self.k_tangential
-        return self.k_normal * factor, self.width / factor, self.k_tangential * factor
+            return np.broadcast_to(self.k_tangential, (n,))
+        return self.k_tangential * factor
 
-    @staticmethod
-    def _shifts(multipliers: Optional[np.ndarray], kn):
+    def _shifts(self, multipliers: Optional[np.ndarray]):
         """(gap shift lambda_N / k_N (n,) [mm], tangential multiplier (n, 2) [MPa]); the scalar
         0.0 for both without multipliers."""
         if multipliers is None:
             return 0.0, 0.0
         lam = np.asarray(multipliers)
-        return lam[:, 0] / kn, lam[:, 1:]
+        return lam[:, 0] / self.k_normal, lam[:, 1:]
 
     @staticmethod
     def _trial_traction(jump: np.ndarray, committed: InterfaceState, lam_t, kt) -> np.ndarray:
-        """Elastic predictor tau = lambda_T + k_T (s - s_p) (n, 2) [MPa] (k_T a number or
-        (n,))."""
-        return lam_t + np.reshape(kt, (-1, 1)) * (jump[:, 1:] - committed.plastic_slip)
+        """Elastic predictor tau = lambda_T + k_T (s - s_p) (n, 2) [MPa] (k_T (n,))."""
+        return lam_t + kt[:, None] * (jump[:, 1:] - committed.plastic_slip)
 
     def coulomb_limit(self) -> CoulombLimit:
         """Signorini contact with Coulomb's mu (0 without tangential stiffness) and this law's
@@ -208,21 +207,16 @@ class SoftplusPenalty:
 
     def normal(self, g: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Pressure p(g) [MPa] and stiffness k = -dp/dg [MPa/mm] at gaps g (n,) [mm]."""
-        return self._normal(g, self.k_normal, self.width)
-
-    @staticmethod
-    def _normal(g, kn, w) -> tuple[np.ndarray, np.ndarray]:
-        """:meth:`normal` with the penalty k_N and width w given (numbers or (n,))."""
-        z = -np.asarray(g, dtype=float) / w
-        return kn * w * np.logaddexp(0.0, z), kn * expit(z)
+        z = -np.asarray(g, dtype=float) / self.width
+        return self.k_normal * self.width * np.logaddexp(0.0, z), self.k_normal * expit(z)
 
     def evaluate(self, jump: np.ndarray, committed: InterfaceState,
                  multipliers: Optional[np.ndarray] = None,
-                 factor: Optional[np.ndarray] = None) -> LawResult:
+                 tangential_factor: Optional[np.ndarray] = None) -> LawResult:
         """Traction (n, 3) and tangent (n, 3, 3) at jump (n, 3) [mm]; pure (no mutation).
         ``multipliers`` (n, 3) shift the penalty (see the class; None: the plain penalty).
-        ``factor`` (n,) > 0: per-point penalties, k_N and k_T times it and w divided by it
-        (None: the law's; checked by :meth:`with_multipliers`).
+        ``tangential_factor`` (n,) > 0: each point's k_T times it (None: the law's k_T;
+        checked by :meth:`with_multipliers`).
 
         The trial state carries the plastic slip and, for the record, the slip magnitudes
         (``accumulated_slip``, ``slip_path``); Coulomb friction does not harden.
@@ -235,9 +229,8 @@ class SoftplusPenalty:
         if multipliers is not None and np.shape(multipliers) != (n, 3):
             raise ValueError(f"multipliers of shape {np.shape(multipliers)} for {n} points; "
                              f"expected ({n}, 3)")
-        kn, w, kt = self._penalties(factor)
-        shift, lam_t = self._shifts(multipliers, kn)
-        p, k = self._normal(jump[:, 0] - shift, kn, w)
+        shift, lam_t = self._shifts(multipliers)
+        p, k = self.normal(jump[:, 0] - shift)
         traction = np.zeros((n, 3))
         tangent = np.zeros((n, 3, 3))
         traction[:, 0] = -p
@@ -246,7 +239,7 @@ class SoftplusPenalty:
         dissipation = np.zeros(n)
         slipping = np.zeros(n, dtype=bool)
         if self.k_tangential > 0.0:
-            kt = np.broadcast_to(kt, (n,))
+            kt = self._kt(n, tangential_factor)
             tau = self._trial_traction(jump, committed, lam_t, kt)
             norm = np.linalg.norm(tau, axis=1)
             limit = self.friction * p
@@ -281,7 +274,7 @@ class SoftplusPenalty:
             tangent=tangent,
             state=state,
             dissipation=dissipation,
-            area_fraction=expit(-(jump[:, 0] - shift) / w),
+            area_fraction=expit(-(jump[:, 0] - shift) / self.width),
             contact=p > 0.0,
             slipping=slipping,
         )
@@ -289,7 +282,7 @@ class SoftplusPenalty:
     def newton_tangent(self, jump: np.ndarray, committed: InterfaceState, result: LawResult,
                        previous: Optional[np.ndarray],
                        multipliers: Optional[np.ndarray] = None,
-                       factor: Optional[np.ndarray] = None
+                       tangential_factor: Optional[np.ndarray] = None
                        ) -> tuple[np.ndarray, np.ndarray]:
         """Tangent for a Newton step at ``jump`` (pure; the residual is not affected).
 
@@ -305,14 +298,13 @@ class SoftplusPenalty:
             stiffness ``reversal_stiffness`` k_T |t_T| / |tau| added along m = tau / |tau| at
             slipping points whose trial direction reversed since ``previous`` (see the
             class); memo = (n, 2) trial directions m, to pass as ``previous`` next time.
-            ``multipliers``, ``factor``: those ``result`` was computed with (None: plain
-            penalty; the law's own penalties).
+            ``multipliers``, ``tangential_factor``: those ``result`` was computed with (None:
+            plain penalty; the law's own k_T).
         """
         if self.k_tangential <= 0.0:
             return result.tangent, None
-        kn, _, kt = self._penalties(factor)
-        kt = np.broadcast_to(kt, (jump.shape[0],))
-        tau = self._trial_traction(jump, committed, self._shifts(multipliers, kn)[1], kt)
+        kt = self._kt(jump.shape[0], tangential_factor)
+        tau = self._trial_traction(jump, committed, self._shifts(multipliers)[1], kt)
         norm = np.linalg.norm(tau, axis=1)
         m = np.divide(tau, norm[:, None], out=np.zeros_like(tau), where=norm[:, None] > 0.0)
         tangent = result.tangent
@@ -331,12 +323,12 @@ class SoftplusPenalty:
 @dataclass(frozen=True)
 class ShiftedSoftplusPenalty:
     """A :class:`SoftplusPenalty` with its penalty shifted by multipliers (n, 3) [MPa]: what
-    ``SoftplusPenalty.with_multipliers`` returns for one evaluation of n points; ``factor``
-    (n,): per-point penalties (k_N, k_T times it, w divided by it; None: the law's)."""
+    ``SoftplusPenalty.with_multipliers`` returns for one evaluation of n points;
+    ``tangential_factor`` (n,): each point's k_T times it (None: the law's)."""
 
     law: SoftplusPenalty
     multipliers: np.ndarray
-    factor: Optional[np.ndarray] = None
+    tangential_factor: Optional[np.ndarray] = None
 
     def initial_state(self, n_pts: int) -> InterfaceState:
         """Virgin history at n_pts points (that of the plain law)."""
@@ -344,12 +336,12 @@ class ShiftedSoftplusPenalty:
 
     def evaluate(self, jump: np.ndarray, committed: InterfaceState) -> LawResult:
         """The shifted law at ``jump`` (see :meth:`SoftplusPenalty.evaluate`)."""
-        return self.law.evaluate(jump, committed, self.multipliers, self.factor)
+        return self.law.evaluate(jump, committed, self.multipliers, self.tangential_factor)
 
     def newton_tangent(self, jump, committed, result, previous):
         """See :meth:`SoftplusPenalty.newton_tangent`."""
         return self.law.newton_tangent(jump, committed, result, previous, self.multipliers,
-                                       self.factor)
+                                       self.tangential_factor)
 
     def max_friction_coefficient(self) -> float:
         """That of the plain law."""

@@ -335,11 +335,12 @@ def test_stiffness_factor_scales_the_shifted_penalty():
         law.with_multipliers(lam, 0.0)
 
 
-def test_per_point_stiffness_factor_is_each_point_with_its_own_penalty():
-    """with_multipliers(lambda, f) with f one per point: each point evaluates as the law
-    built with k_N, k_T x f_i and the width / f_i (a separate SoftplusPenalty per value of f,
-    evaluated on its own points), traction, tangent, plastic slip and the Newton tangent with
-    a reversal; a scalar factor is unchanged; bad per-point factors are refused."""
+def test_tangential_factor_is_each_point_with_its_own_kt():
+    """with_multipliers(lambda, f, tangential_factor=g) with g one per point: each point
+    evaluates as the law built with k_T x g_i (and f on everything; a separate SoftplusPenalty
+    per value of g, evaluated on its own points): traction, tangent, plastic slip and the
+    Newton tangent with a reversal; the normal part is that of the law without g; bad
+    per-point factors are refused."""
     law = SoftplusPenalty(1e4, 1e-3, k_tangential=5e3, friction=0.3)
     rng = np.random.default_rng(8)
     n = 60
@@ -348,15 +349,15 @@ def test_per_point_stiffness_factor_is_each_point_with_its_own_penalty():
     st.plastic_slip[:] = rng.normal(0, 1e-4, (n, 2))
     lam = np.column_stack([rng.uniform(0, 5, n), rng.normal(0, 1, (n, 2))])
     values = np.array([0.5, 2.0, 7.0])
-    f = values[rng.integers(0, 3, n)]
-    shifted = law.with_multipliers(lam, f)
+    g = values[rng.integers(0, 3, n)]
+    shifted = law.with_multipliers(lam, 3.0, g)
     r = shifted.evaluate(jump, st)
     previous = -rng.normal(size=(n, 2))          # reversed directions at about half the points
     tan, _ = shifted.newton_tangent(jump, st, r, previous)
     slipping = 0
     for v in values:
-        i = np.flatnonzero(f == v)
-        built = SoftplusPenalty(1e4 * v, 1e-3 / v, k_tangential=5e3 * v, friction=0.3)
+        i = np.flatnonzero(g == v)
+        built = SoftplusPenalty(3e4, 1e-3 / 3, k_tangential=1.5e4 * v, friction=0.3)
         sub = InterfaceState.zeros(i.size)
         sub.plastic_slip[:] = st.plastic_slip[i]
         ref = built.with_multipliers(lam[i]).evaluate(jump[i], sub)
@@ -370,20 +371,21 @@ def test_per_point_stiffness_factor_is_each_point_with_its_own_penalty():
         np.testing.assert_allclose(tan[i], ref_tan, rtol=1e-13, atol=1e-9)
         slipping += int(ref.slipping.sum())
     assert 0 < slipping < n                       # both branches were compared
-    np.testing.assert_array_equal(law.with_multipliers(lam, 2.0).evaluate(jump, st).traction,
-                                  law.with_multipliers(lam, np.full(n, 2.0))
-                                  .evaluate(jump, st).traction)
-    for bad, match in ((f[:-1], r"shape \(59,\) for 60 points"),
-                       (np.where(np.arange(n) == 3, 0.0, f), r"stiffness_factor\[3\] = 0.0"),
-                       (np.where(np.arange(n) == 4, np.nan, f), r"stiffness_factor\[4\] = nan")):
+    np.testing.assert_array_equal(r.traction[:, 0], law.with_multipliers(lam, 3.0)
+                                  .evaluate(jump, st).traction[:, 0])
+    for bad, match in ((g[:-1], r"shape \(59,\) for 60 points"),
+                       (np.where(np.arange(n) == 3, 0.0, g), r"tangential_factor\[3\] = 0.0"),
+                       (np.where(np.arange(n) == 4, np.nan, g),
+                        r"tangential_factor\[4\] = nan"),
+                       ("x", "tangential_factor")):
         with pytest.raises(ValueError, match=match):
-            law.with_multipliers(lam, bad)
+            law.with_multipliers(lam, 1.0, bad)
 
 
 def test_reference_spacing_scales_the_penalty_with_the_point_spacing():
     """AugmentedLagrangian(reference_spacing=h): the law at each point is the one with the
-    factor h / h_j (and stiffness_factor on top); without the points' spacing, or with a bad
-    reference, it is refused."""
+    tangential factor h / h_j (and stiffness_factor on everything); without the points'
+    spacing, or with a bad reference, it is refused."""
     law = SoftplusPenalty(1e4, 1e-3, k_tangential=5e3, friction=0.3)
     rng = np.random.default_rng(9)
     n = 20
@@ -393,7 +395,7 @@ def test_reference_spacing_scales_the_penalty_with_the_point_spacing():
     spacing = rng.uniform(0.01, 0.05, n)
     enf = AugmentedLagrangian(reference_spacing=0.05, stiffness_factor=3.0)
     r = enf.law_for(law, lam, spacing).evaluate(jump, st)
-    ref = law.with_multipliers(lam, 3.0 * 0.05 / spacing).evaluate(jump, st)
+    ref = law.with_multipliers(lam, 3.0, 0.05 / spacing).evaluate(jump, st)
     np.testing.assert_array_equal(r.traction, ref.traction)
     with pytest.raises(ValueError, match="only the nodal point set knows"):
         enf.law_for(law, lam, None)

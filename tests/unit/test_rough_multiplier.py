@@ -411,10 +411,11 @@ def test_stiffness_factor_is_the_law_with_a_stiffer_kt(regime):
     fd_check(shifted, jump, st, keep)
 
 
-def test_per_point_stiffness_factor_is_each_point_with_its_own_kt():
-    """A stiffness factor per point: each point evaluates as the law with that point's factor
-    given as a number (the factor moves from c to the stiffness, a different product order,
-    hence 1e-12 and not bit equality); its tangent matches central differences."""
+def test_tangential_factor_is_each_point_with_its_own_kt():
+    """A tangential factor per point: each point evaluates as the law with that point's factor
+    given as the stiffness factor (the factor moves from c to the stiffness, a different
+    product order, hence 1e-12 and not bit equality); its tangent matches central
+    differences; the normal part is untouched."""
     law = InterfaceLaw(ExponentialNormal(), TS, ORTHO, h0=1e-3)
     rng = np.random.default_rng(12)
     n = 300
@@ -423,16 +424,19 @@ def test_per_point_stiffness_factor_is_each_point_with_its_own_kt():
                             st.plastic_slip + rng.normal(size=(n, 2)) * 3e-5])
     lam = multipliers_for(law, jump, rng, 1.2)
     values = np.array([1.0, 4.0, 30.0])
-    f = values[rng.integers(0, 3, n)]
-    shifted = law.with_multipliers(lam, f)
+    g = values[rng.integers(0, 3, n)]
+    shifted = law.with_multipliers(lam, 2.0, g)
     r = shifted.evaluate(jump, st)
     for v in values:
-        i = np.flatnonzero(f == v)
+        i = np.flatnonzero(g == v)
         sub = InterfaceState(st.plastic_slip[i], st.accumulated_slip[i], st.slip_path[i])
-        ref = law.with_multipliers(lam[i], v).evaluate(jump[i], sub)
+        ref = law.with_multipliers(lam[i], 2.0 * v).evaluate(jump[i], sub)
         np.testing.assert_allclose(r.traction[i], ref.traction, rtol=1e-12, atol=1e-15)
         np.testing.assert_allclose(r.tangent[i], ref.tangent, rtol=1e-12, atol=1e-9)
         np.testing.assert_array_equal(r.slipping[i], ref.slipping)
+    np.testing.assert_array_equal(r.traction[:, 0], law.evaluate(jump, st).traction[:, 0])
     assert 0.1 < r.slipping[r.contact].mean() < 0.9
     keep = np.abs(trial_ratio(law, jump, st, lam[:, 1:]) - 1.0) > 1e-4
     fd_check(shifted, jump, st, keep)
+    with pytest.raises(ValueError, match=r"tangential_factor\[0\] = -1.0"):
+        law.with_multipliers(lam, 1.0, -np.ones(n))
