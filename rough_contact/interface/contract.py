@@ -355,6 +355,6 @@ def check_point_factor(name: str, factor, n: int) -> np.ndarray:
     bad = ~(np.isfinite(f) & (f > 0.0))
     if bad.any():
         i = int(np.flatnonzero(bad)[0])
-        raise ValueError(f"{name}[{i}] = {f[i]!r} is invalid ({int(bad.sum())} of {n} "
+        raise ValueError(f"{name}[{i}] = {float(f[i])!r} is invalid ({int(bad.sum())} of {n} "
                          f"points): it must be finite and > 0")
     return f
