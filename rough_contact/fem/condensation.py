@@ -139,8 +139,8 @@ class DualCondensation:
             # the combined rows T F carry one traction each (docs/exact_contact_newton.md,
             # section 4); checked: isotropic blocks, sum over the first surface's columns =
             # sign (rigid translation), own coefficient x T_jj = sign
-            every = np.concatenate(comm.allgather(nodal.vertex))
-            first = np.isin(nodal.nodes, every) & ~nodal.pad
+            first = _owned_flag_at(comm, imap.size_local, imap.local_range[0], nodal.vertex,
+                                   nodal.nodes) & ~nodal.pad
             t_jj = np.ones(n_v)
             diag = comb.row == comb.col
             t_jj[np.searchsorted(nodal.vertex, comb.row[diag])] = comb.value[diag]
@@ -343,3 +343,30 @@ class DualCondensation:
             self._L.setValuesRCV(*self._s_blocks(Ls, Lg), addv=PETSc.InsertMode.INSERT_VALUES)
         self._L.assemble()
         self._L.matMult(self._Kg, result=A)
+
+
+def _owned_flag_at(comm, n_owned: int, first_owned: int, flagged: np.ndarray,
+                   wanted: np.ndarray) -> np.ndarray:
+    """Whether each of ``wanted`` (global node indices, any shape, any rank's nodes) is among
+    the ``flagged`` nodes of some rank (each rank flags nodes it owns: global indices in
+    [first_owned, first_owned + n_owned)). Collective; one PETSc scatter of the wanted entries
+    from a distributed flag vector, so memory is O(owned + wanted) per rank, whatever the
+    number of ranks (an allgather of every rank's list would be O(all flagged))."""
+    flags = PETSc.Vec().createMPI((n_owned, PETSc.DECIDE), comm=comm)
+    r0, r1 = flags.getOwnershipRange()
+    if r0 != first_owned or r1 != first_owned + n_owned:
+        raise RuntimeError(f"node ownership [{r0}, {r1}) of the flag vector differs from the "
+                           f"index map's [{first_owned}, {first_owned + n_owned})")
+    flags.set(0.0)
+    flags.array[np.asarray(flagged, dtype=np.int64) - first_owned] = 1.0
+    uniq, inv = np.unique(np.asarray(wanted, dtype=np.int64), return_inverse=True)
+    got = PETSc.Vec().createSeq(uniq.size, comm=PETSc.COMM_SELF)
+    is_from = PETSc.IS().createGeneral(uniq.astype(PETSc.IntType), comm=PETSc.COMM_SELF)
+    scatter = PETSc.Scatter().create(flags, is_from, got, None)
+    try:
+        scatter.scatter(flags, got, PETSc.InsertMode.INSERT, PETSc.ScatterMode.FORWARD)
+        out = got.getArray().copy() > 0.5
+    finally:
+        for obj in (scatter, is_from, got, flags):
+            obj.destroy()
+    return out[inv.reshape(np.shape(wanted))]
