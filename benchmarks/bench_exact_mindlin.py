@@ -106,6 +106,9 @@ def main(argv=None):
                     "the multipliers converge")
     ap.add_argument("--al-tol", type=float, default=1e-4)
     ap.add_argument("--nu", type=float, default=0.49)
+    ap.add_argument("--width-ratio", type=float, default=1e-3,
+                    help="the softplus smoothing length w / delta (mindlin.run(width_ratio=)); "
+                    "its pressure tail beyond the contact's edge scales as w^(2/3)")
     ap.add_argument("--half-width", type=float, default=4.0,
                     help="block half width L [mm] (the half model is [-L, L] x [0, L] x [-H, 0])")
     ap.add_argument("--height", type=float, default=4.0, help="block height H [mm]")
@@ -139,7 +142,8 @@ def main(argv=None):
                     k_tangential=args.k_tangential, half_width=args.half_width,
                     height=args.height, mesh_size=args.mesh_size,
                     transition=args.transition, refined_radius=args.refined_radius,
-                    front_band=args.front_band, verbose=args.verbose)
+                    front_band=args.front_band, width_ratio=args.width_ratio,
+                    verbose=args.verbose)
     E_star = E / (1.0 - args.nu**2)
     q = r.Q / (r.mu * r.P)
     PETSc.Sys.Print(f"{'t':>6} {'P [N]':>8} {'P/Hertz-1':>9} {'Q/muP':>7} {'c/a MD':>7} "
