@@ -166,8 +166,8 @@ def energy(levels, amplitudes, kt=None, kt_scale=None, ring_size=None, ring_band
            verbose=False, steps_per_cycle=16, scene=None):
     """``scene``: further arguments of ``mindlin.run`` (block, mesh, points, enforcement).
     ``ring_growth``: the ring's growth to the contact size, a fraction of Hertz's radius.
-    ``scene["local_penalty"]``: the enforcement's penalty scaled with the vertex spacing
-    (``reference_spacing`` = the level's size)."""
+    ``scene["local_penalty"]``: the enforcement's tangential penalty scaled with the vertex
+    spacing (``reference_spacing`` = the level's size)."""
     scene = dict(scene or {})
     local = scene.pop("local_penalty", False)
     PETSc.Sys.Print(f"{'h':>6} {'DOFs':>7} {'ampl':>5} {'Q*/muP':>6} {'W FE':>10} {'loop':>10} "
@@ -243,9 +243,9 @@ def main(argv=None):
                     "Newton (NewtonAugmentedLagrangian(--al-tol); needs --points nodal)")
     ap.add_argument("--al-tol", type=float, default=1e-4)
     ap.add_argument("--local-penalty", action="store_true",
-                    help="energy, with --exact: the penalties chosen for the level's size h "
-                    "scaled at each vertex by h / h_j (NewtonAugmentedLagrangian("
-                    "reference_spacing=h)): the ring's vertices get a stiffer penalty, fewer "
+                    help="energy, with --exact: the tangential penalty chosen for the level's "
+                    "size h scaled at each vertex by h / h_j (NewtonAugmentedLagrangian("
+                    "reference_spacing=h)): the ring's vertices get a stiffer one, fewer "
                     "Newton iterations, the same fixed point")
     ap.add_argument("--half-width", type=float, default=4.0, help="block half width L [mm]")
     ap.add_argument("--height", type=float, default=4.0, help="block height H [mm]")
