@@ -22,6 +22,7 @@ Units: mm, N, MPa.
 from __future__ import annotations
 
 import argparse
+import os
 import time
 from dataclasses import replace
 
@@ -30,6 +31,7 @@ from petsc4py import PETSc
 
 from rough_contact import references
 from rough_contact.interface.enforcement import NewtonAugmentedLagrangian
+from rough_contact.solver.checkpoint import has_checkpoint
 from rough_contact.scenes import mindlin
 
 E, NU, MU, R, DELTA = 2.0e5, 0.49, 0.3, 10.0, 4e-3
@@ -170,6 +172,7 @@ def energy(levels, amplitudes, kt=None, kt_scale=None, ring_size=None, ring_band
     spacing (``reference_spacing`` = the level's size)."""
     scene = dict(scene or {})
     local = scene.pop("local_penalty", False)
+    ckpt_root = scene.pop("checkpoint", None)
     PETSc.Sys.Print(f"{'h':>6} {'DOFs':>7} {'ampl':>5} {'Q*/muP':>6} {'W FE':>10} {'loop':>10} "
                     f"{'W MD':>10} {'error':>7} {'loop e':>7} {'trap':>7} {'Masing':>7} "
                     f"{'Newton':>6} {'time s':>6} "
@@ -182,6 +185,14 @@ def energy(levels, amplitudes, kt=None, kt_scale=None, ring_size=None, ring_band
             scene["enforcement"] = replace(scene["enforcement"], reference_spacing=h)
         for amp in amplitudes:
             t0, c0 = time.perf_counter(), time.process_time()
+            if ckpt_root is not None:
+                # one directory per run; an existing checkpoint there is continued (the time
+                # columns are then this call's only)
+                ckpt = os.path.join(ckpt_root, f"h{h:g}_amp{amp:g}")
+                scene["checkpoint"] = ckpt
+                scene["restart"] = ckpt if has_checkpoint(ckpt) else None
+                if scene["restart"] is not None:
+                    PETSc.Sys.Print(f"continuing from the checkpoint in {ckpt}")
             r = mindlin.run(contact_size=h, order=2, nu=NU, mu=MU,
                             slide=amp * gross_slide(L, H), cycles=2,
                             shear_steps=steps_per_cycle, k_tangential=_kt(h, kt, kt_scale),
@@ -247,6 +258,10 @@ def main(argv=None):
                     "size h scaled at each vertex by h / h_j (NewtonAugmentedLagrangian("
                     "reference_spacing=h)): the ring's vertices get a stiffer one, fewer "
                     "Newton iterations, the same fixed point")
+    ap.add_argument("--checkpoint", default=None, metavar="DIR",
+                    help="energy: a checkpoint per increment in DIR/h<h>_amp<amplitude>; a run "
+                    "whose directory holds one continues from it (a killed run loses no "
+                    "converged increment; CPU and time columns then cover this call only)")
     ap.add_argument("--half-width", type=float, default=4.0, help="block half width L [mm]")
     ap.add_argument("--height", type=float, default=4.0, help="block height H [mm]")
     ap.add_argument("--mesh-size", type=float, default=1.0, help="far element size [mm]")
@@ -272,6 +287,7 @@ def main(argv=None):
         elif args.local_penalty:
             ap.error("--local-penalty needs --exact")
         scene["local_penalty"] = args.local_penalty
+        scene["checkpoint"] = args.checkpoint
         energy(args.levels, args.amplitudes, args.k_tangential, args.kt_scale, args.ring,
                args.ring_band, args.ring_growth, args.width_ratio, args.augmented,
                args.quadrature_degree, args.verbose, args.steps_per_cycle, scene)

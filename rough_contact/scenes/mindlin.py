@@ -46,7 +46,7 @@ from rough_contact.solver.loading import load_path
 from rough_contact.solver.program import LoadProgram
 from rough_contact.solver.snes import SNESSolver
 from rough_contact.stick_front import contact_front, stick_front
-from rough_contact.validation import check_scalar
+from rough_contact.validation import check_integer, check_scalar
 
 __all__ = ["ParaboloidIndenter", "KT_SCALE", "MindlinRun", "PointSnapshot", "run"]
 
@@ -65,6 +65,10 @@ class ParaboloidIndenter:
 
     def __init__(self, radius: float):
         self.radius = check_scalar("radius", radius, lo=0.0, unit="mm")
+
+    def describe(self) -> dict:
+        """Its parameters, for a checkpoint's fingerprint (``rough_contact.fingerprint``)."""
+        return {"radius": float(self.radius)}
 
     def gap_and_normal(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         x = np.asarray(x, dtype=float).reshape(-1, 3)
@@ -193,6 +197,23 @@ def _gather_points(comm, x, arrays):
     return xs[order], data[order]
 
 
+class _Record:
+    """The per-increment rows and gathered points of :func:`run`, kept with the checkpoints
+    (``rough_contact.solver.checkpoint.ResumableOutput``; the same on every rank)."""
+
+    def __init__(self):
+        self.rows: list = []
+        self.snaps: list = []
+        self.x_near: Optional[np.ndarray] = None
+
+    def checkpoint_state(self) -> tuple:
+        return list(self.rows), list(self.snaps), self.x_near
+
+    def restore(self, state) -> None:
+        rows, snaps, x_near = state
+        self.rows, self.snaps, self.x_near = list(rows), list(snaps), x_near
+
+
 def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5, nu=0.49,
         mu=0.3, penalty=INDENTER_PENALTY, half_width=4.0, height=4.0, mesh_size=1.0, preload_steps=2,
         shear_steps=12, cycles=0, indenter="paraboloid", quadrature_degree=None,
@@ -201,7 +222,7 @@ def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5
         augmented=False, augmentation_tolerance=1e-3, points="quadrature", transition=1.0,
         refined_radius=0.4, gather_radius=1.5, front_band=0.5,
         max_updates=30, basis="standard", enforcement=None, comm=MPI.COMM_WORLD,
-        verbose=False) -> MindlinRun:
+        verbose=False, checkpoint=None, restart=None, stop_after=None) -> MindlinRun:
     """Normal indentation by ``delta`` [mm], then a tangential bottom displacement: monotonic to
     ``slide`` [mm] (``cycles`` = 0) or ``cycles`` triangle cycles of amplitude ``slide``.
 
@@ -262,6 +283,14 @@ def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5
     ``slide`` defaults to the approach at which Mindlin's Q reaches mu P for Hertz's P at
     ``delta`` plus the block's shear compliance (so the last increments slide).
 
+    ``checkpoint``: a directory receiving a checkpoint after every converged increment
+    (``rough_contact.solver.checkpoint``), the rows and gathered points so far included;
+    ``restart``: such a directory to continue from (the same arguments; the result then
+    covers the whole run, the restored increments included); ``stop_after``: stop after this
+    many increments solved by this call (the result covers the increments done). A run of
+    hours (a small Mindlin–Deresiewicz amplitude on a ring-refined mesh) can so be split over
+    several sessions and loses no converged increment when killed.
+
     Returns:
         :class:`MindlinRun` (identical on every rank): per increment the bottom slide, P, Q,
         the FE stick ratio, the contact area, the dissipation; and the scene's constants
@@ -269,6 +298,8 @@ def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5
     """
     check_scalar("delta", delta, lo=0.0, unit="mm")
     check_scalar("mu", mu, lo=0.0)
+    if stop_after is not None:
+        check_integer("stop_after", stop_after, lo=1, what="increments")
     check_points_basis(points, basis)
     if enforcement is not None and augmented:
         raise ValueError(f"enforcement = {enforcement!r} with augmented = True is invalid: "
@@ -329,9 +360,9 @@ def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5
                     PrescribedDisplacement(bottom, (slide, 0.0, 0.0), (0,), channel="shear")],
         programs=prog.channels)
     solver = SNESSolver(problem, prefix="mindlin_")
-    rows, snaps = [], []
-    x_near = None
-    for inc in load_path(problem, solver, prog.times, verbose=verbose):
+    record = _Record()          # restored from the checkpoint on a restart
+    for inc in load_path(problem, solver, prog.times, verbose=verbose, checkpoint=checkpoint,
+                         resume=restart, outputs=[record], max_steps=stop_after):
         R = problem.reaction(bottom)
         pf = ci.point_fields()
         x_loc = ci.point_coordinates()
@@ -340,7 +371,7 @@ def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5
             pf.weight[near], pf.pressure[near], pf.shear[near],
             pf.slipping[near].astype(float)]))
         p_max = comm.allreduce(float(pf.pressure.max(initial=0.0)), op=MPI.MAX)
-        snaps.append(np.column_stack([cols, cols[:, 1] > 1e-3 * p_max]))
+        record.snaps.append(np.column_stack([cols, cols[:, 1] > 1e-3 * p_max]))
         # contact: p above 1e-3 of the peak (the softplus law is positive everywhere; Hertz's
         # p reaches 1e-3 p0 within 5e-7 a of the edge)
         touching = pf.pressure > 1e-3 * p_max
@@ -359,10 +390,17 @@ def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5
                          on & slip_g, band=front_band, inside_slip=True)
         ratio = sf.radius / cf.radius if cf.radius > 0 else float("nan")
         ratio_in = si.radius / cf.radius if cf.radius > 0 else float("nan")
-        rows.append((inc.load_factor, problem.scales["shear"] * slide, 2.0 * R[2], 2.0 * R[0],
-                     stick, 2.0 * A_c, 2.0 * inc.dissipation, inc.newton_total, ratio,
-                     sf.radius, cf.radius, sf.residual, sf.n_misplaced, ratio_in))
+        record.rows.append((inc.load_factor, problem.scales["shear"] * slide, 2.0 * R[2],
+                            2.0 * R[0],
+                            stick, 2.0 * A_c, 2.0 * inc.dissipation, inc.newton_total,
+                            ratio, sf.radius, cf.radius, sf.residual, sf.n_misplaced,
+                            ratio_in))
+        record.x_near = x_near
     solver.destroy()
+    rows, snaps, x_near = record.rows, record.snaps, record.x_near
+    if not rows:
+        raise RuntimeError("the Mindlin run recorded no increment (a restart from a "
+                           "checkpoint that holds none)")
     t, s, P, Q, stick, area, D, newton, front, c_r, a_r, res, mis, front_in = \
         (np.array(c) for c in zip(*rows))
     S = np.array(snaps)
