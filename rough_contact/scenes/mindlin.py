@@ -391,16 +391,12 @@ def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5
         ratio = sf.radius / cf.radius if cf.radius > 0 else float("nan")
         ratio_in = si.radius / cf.radius if cf.radius > 0 else float("nan")
         record.rows.append((inc.load_factor, problem.scales["shear"] * slide, 2.0 * R[2],
-                            2.0 * R[0],
-                            stick, 2.0 * A_c, 2.0 * inc.dissipation, inc.newton_total,
-                            ratio, sf.radius, cf.radius, sf.residual, sf.n_misplaced,
-                            ratio_in))
+                            2.0 * R[0], stick, 2.0 * A_c, 2.0 * inc.dissipation,
+                            inc.newton_total, ratio, sf.radius, cf.radius, sf.residual,
+                            sf.n_misplaced, ratio_in))
         record.x_near = x_near
     solver.destroy()
     rows, snaps, x_near = record.rows, record.snaps, record.x_near
-    if not rows:
-        raise RuntimeError("the Mindlin run recorded no increment (a restart from a "
-                           "checkpoint that holds none)")
     t, s, P, Q, stick, area, D, newton, front, c_r, a_r, res, mis, front_in = \
         (np.array(c) for c in zip(*rows))
     S = np.array(snaps)
