@@ -216,6 +216,30 @@ def energy(levels, amplitudes, kt=None, kt_scale=None, ring_size=None, ring_band
                             f"{trap:+7.4f} "
                             f"{masing_error(r, G, c_b):7.4f} {int(r.newton.sum()):6d} "
                             f"{time.perf_counter() - t0:6.0f} {time.process_time() - c0:6.0f}")
+            first_loading(r)
+
+
+def first_loading(r):
+    """The stick radius on the first loading branch (from the end of the normal load to the
+    first peak) against Cattaneo–Mindlin's c / a = (1 - Q / mu P)^(1/3), and the slip under the
+    normal load alone: the points in contact that slip at the end of the normal load, the
+    innermost one's radius over Hertz's radius (the continuum has none: Spence's annulus is
+    ~1e-21 a at nu = 0.49, mu = 0.3, docs/mindlin_dual.md)."""
+    i0 = int(np.argmin(np.abs(r.t - r.cycle_start)))
+    i1 = int(np.argmin(np.abs(r.t - (r.cycle_start + 0.25))))
+    slip0 = r.points.slipping[i0]
+    inner = float(r.points.r[slip0].min()) / r.a if slip0.any() else float("nan")
+    PETSc.Sys.Print(f"  normal load alone: {int(slip0.sum())} of "
+                    f"{int(r.points.contact[i0].sum())} points in contact slip, the innermost "
+                    f"at r / a_Hertz = {inner:.4f}")
+    PETSc.Sys.Print(f"  {'Q/muP':>7} {'c/a FE':>7} {'inside':>7} {'c/a CM':>7} {'error':>7} "
+                    f"{'in err':>7}")
+    for i in range(i0, i1 + 1):
+        q = abs(r.Q[i]) / (r.mu * r.P[i])
+        cm = float(references.stick_ratio(abs(r.Q[i]), r.mu, r.P[i]))
+        PETSc.Sys.Print(f"  {q:7.4f} {r.stick_front[i]:7.4f} {r.stick_front_inside[i]:7.4f} "
+                        f"{cm:7.4f} {r.stick_front[i] / cm - 1:+7.4f} "
+                        f"{r.stick_front_inside[i] / cm - 1:+7.4f}")
 
 
 def main(argv=None):
