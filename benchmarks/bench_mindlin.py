@@ -203,6 +203,13 @@ def energy(levels, amplitudes, kt=None, kt_scale=None, ring_size=None, ring_band
                             augmented=augmented, quadrature_degree=quadrature_degree,
                             verbose=verbose, **scene)
             t, s, Q, D = r.t, r.slide, r.Q, r.dissipation
+            if t[-1] < r.cycle_start + 2.0 - 1e-9:
+                # stopped early (--stop-after): no cycle to measure yet
+                PETSc.Sys.Print(f"{h:6.4f} {r.dofs:7d} {amp:5.2f} stopped at t = {t[-1]:.4f} "
+                                f"after {t.size} increments ({int(r.newton.sum())} Newton)")
+                if t[-1] > r.cycle_start:
+                    first_loading(r)
+                continue
             end1 = int(np.argmin(np.abs(t - 2.0)))
             idx = np.arange(end1, t.size)
             W = D[-1] - D[end1]
@@ -226,7 +233,7 @@ def first_loading(r):
     innermost one's radius over Hertz's radius (the continuum has none: Spence's annulus is
     ~1e-21 a at nu = 0.49, mu = 0.3, docs/mindlin_dual.md)."""
     i0 = int(np.argmin(np.abs(r.t - r.cycle_start)))
-    i1 = int(np.argmin(np.abs(r.t - (r.cycle_start + 0.25))))
+    i1 = int(np.argmin(np.abs(r.t - min(r.cycle_start + 0.25, r.t[-1]))))
     slip0 = r.points.slipping[i0]
     inner = float(r.points.r[slip0].min()) / r.a if slip0.any() else float("nan")
     PETSc.Sys.Print(f"  normal load alone: {int(slip0.sum())} of "
@@ -292,6 +299,10 @@ def main(argv=None):
                     help="energy: a checkpoint per increment in DIR/h<h>_amp<amplitude>; a run "
                     "whose directory holds one continues from it (a killed run loses no "
                     "converged increment; CPU and time columns then cover this call only)")
+    ap.add_argument("--stop-after", type=int, default=None, metavar="N",
+                    help="energy: stop each run after N increments solved by this call (e.g. "
+                    "the normal load and the first loading branch only, whose stick radius is "
+                    "printed; with --checkpoint a later call continues)")
     ap.add_argument("--half-width", type=float, default=4.0, help="block half width L [mm]")
     ap.add_argument("--height", type=float, default=4.0, help="block height H [mm]")
     ap.add_argument("--mesh-size", type=float, default=1.0, help="far element size [mm]")
@@ -318,6 +329,7 @@ def main(argv=None):
             ap.error("--local-penalty needs --exact")
         scene["local_penalty"] = args.local_penalty
         scene["checkpoint"] = args.checkpoint
+        scene["stop_after"] = args.stop_after
         energy(args.levels, args.amplitudes, args.k_tangential, args.kt_scale, args.ring,
                args.ring_band, args.ring_growth, args.width_ratio, args.augmented,
                args.quadrature_degree, args.verbose, args.steps_per_cycle, scene)
