@@ -207,7 +207,7 @@ def energy(levels, amplitudes, kt=None, kt_scale=None, ring_size=None, ring_band
                 # stopped early (--stop-after): no cycle to measure yet
                 PETSc.Sys.Print(f"{h:6.4f} {r.dofs:7d} {amp:5.2f} stopped at t = {t[-1]:.4f} "
                                 f"after {t.size} increments ({int(r.newton.sum())} Newton)")
-                if t[-1] > r.cycle_start:
+                if t[-1] >= r.cycle_start - 1e-9:
                     first_loading(r)
                 continue
             end1 = int(np.argmin(np.abs(t - 2.0)))
@@ -239,6 +239,21 @@ def first_loading(r):
     PETSc.Sys.Print(f"  normal load alone: {int(slip0.sum())} of "
                     f"{int(r.points.contact[i0].sum())} points in contact slip, the innermost "
                     f"at r / a_Hertz = {inner:.4f}")
+    # where they are: per band of r / a_Hertz, the mean radial shear (outwards on the block
+    # positive) over mu p0 and the slipping points
+    rho = r.points.r / r.a
+    e_r = r.points.x[:, :2] / np.maximum(r.points.r, 1e-300)[:, None]
+    t_r = np.einsum("ij,ij->i", r.points.shear[i0], e_r)
+    on = r.points.contact[i0]
+    mu_p0 = r.mu * r.points.pressure[i0].max()
+    bands = (0.9, 0.95, 0.97, 0.98, 0.99, 1.0, 1.01)
+    cells = []
+    for lo, hi in zip(bands[:-1], bands[1:]):
+        m = on & (rho >= lo) & (rho < hi)
+        if m.any():
+            cells.append(f"{lo:g}-{hi:g}: {t_r[m].mean() / mu_p0:+.3f} ({int(slip0[m].sum())})")
+    PETSc.Sys.Print("  mean radial shear / mu p0 (slipping points) by r / a_Hertz: "
+                    + ", ".join(cells))
     PETSc.Sys.Print(f"  {'Q/muP':>7} {'c/a FE':>7} {'inside':>7} {'c/a CM':>7} {'error':>7} "
                     f"{'in err':>7}")
     for i in range(i0, i1 + 1):
