@@ -238,6 +238,13 @@ def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5
     adds its compliance and delays slip (c/a up to 4 % large). docs/mindlin.md has the study.
     ``quadrature_degree``: of the facet rule (default 2 ``order``).
 
+    ``preload_steps``: increments of the normal load. A vertex that closes during an increment
+    sticks where it was at the increment's start, so its stick shear carries the tangential
+    motion of the whole increment. At nu = 0.49 the surface moves inwards under the pressure,
+    and 2 increments leave the edge annulus (about 0.985-1 a) slipping under the normal load
+    alone; about 8 remove that systematic shear (docs/mindlin_dual.md, session 18). It matters
+    when the tangential load is small (Q / mu P below about 0.05).
+
     ``ring_size``: element size [mm] in the annulus ``ring_band`` (fractions of Hertz's radius
     sqrt(R delta)) where the slip zone of a small tangential load lies (c/a = 0.95 at
     Q/mu P = 0.15, a ring 0.05 a wide); default: no ring, ``contact_size`` everywhere in the
