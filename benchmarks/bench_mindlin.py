@@ -188,7 +188,9 @@ def energy(levels, amplitudes, kt=None, kt_scale=None, ring_size=None, ring_band
             if ckpt_root is not None:
                 # one directory per run; an existing checkpoint there is continued (the time
                 # columns are then this call's only)
-                ckpt = os.path.join(ckpt_root, f"h{h:g}_amp{amp:g}")
+                pre = scene.get("preload_steps", 2)
+                ckpt = os.path.join(ckpt_root, f"h{h:g}_amp{amp:g}"
+                                    + (f"_p{pre}" if pre != 2 else ""))
                 scene["checkpoint"] = ckpt
                 scene["restart"] = ckpt if has_checkpoint(ckpt) else None
                 if scene["restart"] is not None:
@@ -311,7 +313,8 @@ def main(argv=None):
                     "reference_spacing=h)): the ring's vertices get a stiffer one, fewer "
                     "Newton iterations, the same fixed point")
     ap.add_argument("--checkpoint", default=None, metavar="DIR",
-                    help="energy: a checkpoint per increment in DIR/h<h>_amp<amplitude>; a run "
+                    help="energy: a checkpoint per increment in DIR/h<h>_amp<amplitude> "
+                    "(_p<N> appended for --preload-steps N other than 2); a run "
                     "whose directory holds one continues from it (a killed run loses no "
                     "converged increment; CPU and time columns then cover this call only)")
     ap.add_argument("--stop-after", type=int, default=None, metavar="N",
