@@ -15,7 +15,10 @@ reaches mu P): the interface dissipation of the second cycle and the loop area o
 bottom slide (trapezoids) against Mindlin–Deresiewicz at the measured amplitude Q* ("error",
 "loop e"; "trap": the trapezoids' own error on Masing's closed-form loop sampled at the same
 steps, -6.3 % at 8 steps per cycle, -1.6 % at 16), and the second cycle's descending branch
-against Masing's (largest |Q - Q_Masing| / Q*).
+against Masing's (largest |Q - Q_Masing| / Q*). After each energy run: the first loading
+branch's stick radius c/a_FE against (1 - Q / mu P)^(1/3) and where points slip under the normal
+load alone (--stop-after N stops a run after N increments, e.g. 6: the normal load and that
+branch only).
 Units: mm, N, MPa.
 """
 
