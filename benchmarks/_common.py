@@ -79,3 +79,18 @@ def punch_memory_law(cache_dir, rtol=1e-3, comm=None, material="paper"):
     if comm is not None:
         out = comm.bcast(out, root=0)
     return out
+
+
+def edge_bands(points, i, a, edges):
+    """Per band [lo, hi) of r / ``a`` of the points in contact at increment ``i`` of a
+    ``rough_contact.scenes.mindlin.PointSnapshot``: (lo, hi, in-band mask) for the non-empty
+    bands, and the radial (outwards on the block positive) and hoop shears (n,) [MPa]."""
+    import numpy as np
+    rad, sh = points.r, points.shear[i]
+    e_r = points.x[:, :2] / np.maximum(rad, 1e-300)[:, None]
+    t_r = np.sum(sh * e_r, axis=1)
+    t_h = e_r[:, 0] * sh[:, 1] - e_r[:, 1] * sh[:, 0]
+    on = points.contact[i]
+    bands = [(lo, hi, on & (rad >= lo * a) & (rad < hi * a))
+             for lo, hi in zip(edges[:-1], edges[1:])]
+    return [b for b in bands if b[2].any()], t_r, t_h

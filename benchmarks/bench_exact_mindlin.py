@@ -32,6 +32,7 @@ import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
 
+from _common import edge_bands
 from rough_contact import references
 from rough_contact.interface.enforcement import NewtonAugmentedLagrangian, SemismoothNewton
 from rough_contact.scenes import mindlin
@@ -66,25 +67,20 @@ def _edge_profile(r, E_star, i):
     the points in contact, the mean radial shear, the rms hoop shear, the smallest margin
     m = mu p - |t| (all / mu p0) and the slipping points."""
     pts = r.points
-    rad = pts.r
     a_h = references.hertz_radius(r.P[i], R, E_star)
     p0 = references.hertz_peak_pressure(r.P[i], a_h)
-    on, sl, sh = pts.contact[i], pts.slipping[i], pts.shear[i]
-    er = pts.x[:, :2] / np.maximum(rad, 1e-300)[:, None]
-    t_r = np.sum(sh * er, axis=1)
-    t_h = er[:, 0] * sh[:, 1] - er[:, 1] * sh[:, 0]
+    sl, sh = pts.slipping[i], pts.shear[i]
     m = r.mu * pts.pressure[i] - np.linalg.norm(sh, axis=1)
     s0 = r.mu * p0
     PETSc.Sys.Print(f"\nmargin at t = {r.t[i]:.3f} (a_H = {a_h:.5f} mm, p0 = {p0:.1f} MPa): "
                     "r/a_H bin, points in contact, mean t_r, rms t_theta, min m (/ mu p0), "
                     "slipping")
-    edges = np.array([0.0, 0.5, 0.7, 0.8, 0.85, 0.9, 0.925, 0.95, 0.975, 1.0, 1.025, 1.05, 1.1])
-    for lo, hi in zip(edges[:-1], edges[1:]):
-        b = on & (rad >= lo * a_h) & (rad < hi * a_h)
-        if b.any():
-            PETSc.Sys.Print(f"{lo:5.3f}-{hi:5.3f} {int(b.sum()):4d} {t_r[b].mean() / s0:+8.4f} "
-                            f"{np.sqrt(np.mean(t_h[b] ** 2)) / s0:8.4f} {m[b].min() / s0:8.4f} "
-                            f"{int((b & sl).sum()):4d}")
+    edges = (0.0, 0.5, 0.7, 0.8, 0.85, 0.9, 0.925, 0.95, 0.975, 1.0, 1.025, 1.05, 1.1)
+    bands, t_r, t_h = edge_bands(pts, i, a_h, edges)
+    for lo, hi, b in bands:
+        PETSc.Sys.Print(f"{lo:5.3f}-{hi:5.3f} {int(b.sum()):4d} {t_r[b].mean() / s0:+8.4f} "
+                        f"{np.sqrt(np.mean(t_h[b] ** 2)) / s0:8.4f} {m[b].min() / s0:8.4f} "
+                        f"{int((b & sl).sum()):4d}")
 
 
 def main(argv=None):

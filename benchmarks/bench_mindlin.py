@@ -32,6 +32,7 @@ from dataclasses import replace
 import numpy as np
 from petsc4py import PETSc
 
+from _common import edge_bands
 from rough_contact import references
 from rough_contact.interface.enforcement import NewtonAugmentedLagrangian
 from rough_contact.solver.checkpoint import has_checkpoint
@@ -246,17 +247,10 @@ def first_loading(r):
                     f"at r / a_Hertz = {inner:.4f}")
     # where they are: per band of r / a_Hertz, the mean radial shear (outwards on the block
     # positive) over mu p0 and the slipping points
-    rho = r.points.r / r.a
-    e_r = r.points.x[:, :2] / np.maximum(r.points.r, 1e-300)[:, None]
-    t_r = np.einsum("ij,ij->i", r.points.shear[i0], e_r)
-    on = r.points.contact[i0]
     mu_p0 = r.mu * r.points.pressure[i0].max()
-    bands = (0.9, 0.95, 0.97, 0.98, 0.99, 1.0, 1.01)
-    cells = []
-    for lo, hi in zip(bands[:-1], bands[1:]):
-        m = on & (rho >= lo) & (rho < hi)
-        if m.any():
-            cells.append(f"{lo:g}-{hi:g}: {t_r[m].mean() / mu_p0:+.3f} ({int(slip0[m].sum())})")
+    bands, t_r, _ = edge_bands(r.points, i0, r.a, (0.9, 0.95, 0.97, 0.98, 0.99, 1.0, 1.01))
+    cells = [f"{lo:g}-{hi:g}: {t_r[m].mean() / mu_p0:+.3f} ({int(slip0[m].sum())})"
+             for lo, hi, m in bands]
     PETSc.Sys.Print("  mean radial shear / mu p0 (slipping points) by r / a_Hertz: "
                     + ", ".join(cells))
     PETSc.Sys.Print(f"  {'Q/muP':>7} {'c/a FE':>7} {'inside':>7} {'c/a CM':>7} {'error':>7} "

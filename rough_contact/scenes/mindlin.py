@@ -241,7 +241,7 @@ def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5
     ``preload_steps``: increments of the normal load. A vertex that closes during an increment
     sticks where it was at the increment's start, so its stick shear carries the tangential
     motion of the whole increment. At nu = 0.49 the surface moves inwards under the pressure,
-    and 2 increments leave the edge annulus (about 0.985-1 a) slipping under the normal load
+    and 2 increments leave the edge annulus (about 0.98-1 a) slipping under the normal load
     alone; about 8 remove that systematic shear (docs/mindlin_dual.md, session 18). It matters
     when the tangential load is small (Q / mu P below about 0.05).
 
