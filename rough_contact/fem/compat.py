@@ -27,10 +27,11 @@ import dolfinx.graph
 import dolfinx.io
 import dolfinx.la
 import dolfinx.mesh
+from mpi4py import MPI
 
 __all__ = ["DOLFINX_VERSION", "NEW_API", "vector_space", "petsc_vector", "function_values", "interpolate",
            "element_degree", "geometry_degree", "geometry_dofmap", "cell_dofmap",
-           "node_input_indices", "geometry_input_indices",
+           "node_input_indices", "node_keys", "geometry_input_indices",
            "create_petsc_vector", "form_sparsity", "block_csr_matrix", "near_nullspace",
            "mesh_domain", "create_mesh", "meshtags_from_arrays", "facet_geometry_nodes",
            "set_bc", "set_bc_array", "apply_lifting", "write_meshtags", "DirichletBC"]
@@ -111,6 +112,56 @@ def node_input_indices(V) -> Optional[np.ndarray]:
     xg = msh.geometry.x[geo.reshape(-1)]
     scale = max(1.0, float(np.abs(msh.geometry.x).max(initial=0.0)))
     if np.any(out < 0) or not np.allclose(x, xg, rtol=0.0, atol=1e-12 * scale):
+        return None
+    return out
+
+
+def node_keys(V) -> Optional[np.ndarray]:
+    """(n_local_nodes,) int64 keys of every node of ``V`` on this rank (owned, then ghost) that
+    do not depend on the partition or the number of ranks (collective), or None where none are
+    available.
+
+    A node that is a geometry node is keyed by that node's input index i
+    (:func:`node_input_indices`). Degree 2 on a simplex mesh of affine geometry (P2 on
+    triangles and tetrahedra) is also keyed: a vertex node by i, an edge's midside node by
+    N + min(i, j) N + max(i, j), with i, j its edge's end vertices and N the global number of
+    input nodes, so the keys of the two kinds never meet. Which cell node is which vertex or
+    edge is found from the coordinates (a cell's nodes lie at its vertices and at its edges'
+    midpoints) on one cell and checked on all to 1e-9 of the mesh's extent; anything else
+    (Q2, degree 3, curved cells, N ≥ 3e9) gives None."""
+    keys = node_input_indices(V)
+    msh = V.mesh
+    imap = V.dofmap.index_map
+    n = imap.size_local + imap.num_ghosts
+    comm = msh.comm
+    simplex = msh.topology.cell_type.name in ("triangle", "tetrahedron")
+    usable = (keys is None and simplex and element_degree(V) == 2 and geometry_degree(msh) == 1)
+    if not comm.allreduce(usable, op=MPI.LAND):
+        return keys
+    dofs, geo = cell_dofmap(V), geometry_dofmap(msh)
+    nv = geo.shape[1]
+    edges = np.array([(a, b) for a in range(nv) for b in range(a + 1, nv)], dtype=np.int64)
+    inputs = np.asarray(msh.geometry.input_global_indices, dtype=np.int64)
+    n_input = int(comm.allreduce(int(inputs.max(initial=-1)) + 1, op=MPI.MAX))
+    ok = dofs.shape[1] == nv + len(edges) and n_input < 3_000_000_000
+    out = np.full(n, -1, dtype=np.int64)
+    if ok and len(dofs):
+        xv = msh.geometry.x[geo]                                        # (cells, nv, 3)
+        places = np.concatenate([xv, 0.5 * (xv[:, edges[:, 0]] + xv[:, edges[:, 1]])], axis=1)
+        x = V.tabulate_dof_coordinates()[dofs]                           # (cells, nodes, 3)
+        scale = max(1.0, float(np.ptp(msh.geometry.x, axis=0).max()))
+        first = np.linalg.norm(x[0][:, None, :] - places[0][None, :, :], axis=2)
+        where = np.argmin(first, axis=1)                                 # node -> place
+        ok = (len(np.unique(where)) == len(where)
+              and np.abs(x - places[:, where]).max() <= 1e-9 * scale)
+        if ok:
+            vid = inputs[geo]                                            # (cells, nv)
+            lo = np.minimum(vid[:, edges[:, 0]], vid[:, edges[:, 1]])
+            hi = np.maximum(vid[:, edges[:, 0]], vid[:, edges[:, 1]])
+            place_keys = np.concatenate([vid, n_input + lo * n_input + hi], axis=1)
+            out[dofs.reshape(-1)] = place_keys[:, where].reshape(-1)
+            ok = not np.any(out < 0)
+    if not comm.allreduce(bool(ok), op=MPI.LAND):
         return None
     return out
 

@@ -441,10 +441,12 @@ class ContactProblem:
 
     def owned_node_keys(self) -> Optional[np.ndarray]:
         """(n_owned_nodes,) int64 keys of this rank's owned displacement nodes that do not
-        depend on the partition (the nodes' indices in the arrays the mesh was built from), or
-        None when the space's nodes are not the geometry's (``compat.node_input_indices``)."""
+        depend on the partition (built from the indices of the geometry nodes in the arrays
+        the mesh was built from: a node's own, or for P2 on simplices an edge node's two end
+        vertices'), or None where the space has no such keys (``compat.node_keys``: Q2,
+        degree 3, a curved geometry)."""
         if self._node_keys is False:       # computed once: the mesh does not change
-            keys = compat.node_input_indices(self.V)
+            keys = compat.node_keys(self.V)
             self._node_keys = None if keys is None else keys[: self.V.dofmap.index_map.size_local]
         return self._node_keys
 

@@ -10,12 +10,15 @@ problem and continues; the resumed run reproduces the uninterrupted one to round
 (tests/fem/test_checkpoint.py).
 
 The state is stored by keys that do not depend on the partition: every displacement node by
-its index in the arrays the mesh was built from (``ContactProblem.owned_node_keys``), every
-interface point by its coordinates. A restart finds its own nodes and points among those all
-ranks saved, so it may run on another partition of the same mesh or on another number of ranks
-(tests/demos/test_multiprocess.py: written on 2 ranks, resumed on 1, and the reverse). Where no
-such keys exist (a displacement space of another degree than the geometry, a sliding pairing,
-a law state that is not a dataclass of per-point arrays) the checkpoint is bound to its
+its index in the arrays the mesh was built from, or for a P2 midside node by its edge's two end
+vertices' indices (``ContactProblem.owned_node_keys``), every interface point by its
+coordinates. A restart finds its own nodes and points among those all ranks saved, so it may
+run on another partition of the same mesh or on another number of ranks
+(tests/demos/test_multiprocess.py: written on 2 ranks, resumed on 1, and the reverse, for the
+rough-law program on P1 and the Mindlin scene on P2). Where no such keys exist (a displacement
+space whose nodes are neither the geometry's nor P2 on simplices, e.g. Q2 or degree 3; a
+sliding pairing; a law state that is not a dataclass of per-point arrays) the checkpoint is
+bound to its
 partition: each rank must hold the DOFs, in the same local order, that some rank held (the same
 parts in another rank order are accepted), on the same number of ranks.
 
@@ -394,8 +397,9 @@ def _restore_same_partition(directory: str, problem, path: str, meta: dict, n_sa
         raise CheckpointError(
             f"restart directory {directory!r} was written on {n_saved} rank(s), this run has "
             f"{comm.size}: its state is bound to its partition (no partition-independent keys: "
-            "a space of another degree than the geometry, a sliding pairing or a law state that "
-            "is not a dataclass of per-point arrays); resume on the same number of ranks")
+            "a space other than the geometry's degree or P2 on simplices, a sliding pairing or a "
+            "law state that is not a dataclass of per-point arrays); resume on the same number "
+            "of ranks")
     with open(os.path.join(path, f"rank{comm.rank}.pkl"), "rb") as f:
         own = pickle.load(f)
     # the same partition: every rank must hold the DOFs (in the same local order) that some rank

@@ -4,6 +4,8 @@ printing each converged step and this rank's PID), or resumed from a directory (
 Every mode writes its results (ResultWriter) into OUT.json's name without the suffix + "_out";
 "checkpointed" and "resume" share DIR + "_out". Writes the final figures as JSON (rank 0).
 A fourth argument N makes a "checkpointed" run stop after N increments (its checkpoint written).
+The displacement is P1, or P2 on the same (affine) mesh with RC_WORKER_DEGREE=2 in the
+environment.
 Usage: checkpoint_worker.py MODE DIR OUT.json [N]"""
 
 import json
@@ -26,7 +28,7 @@ PROGRAM = test_checkpoint.PROGRAM = preload_then_cyclic(preload_steps=2, cycles=
 
 
 def model():
-    return test_checkpoint._model()
+    return test_checkpoint._model(degree=int(os.environ.get("RC_WORKER_DEGREE", "1")))
 
 
 def main(mode, directory, out, stop_after=None):

@@ -44,8 +44,9 @@ ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIR
            OPENBLAS_NUM_THREADS="1")
 
 
-def _run(mode, directory, out, timeout=600, ranks=2, stop_after=None):
-    proc = subprocess.run(worker_cmd(mode, directory, out, ranks, stop_after), env=ENV,
+def _run(mode, directory, out, timeout=600, ranks=2, stop_after=None, degree=1):
+    proc = subprocess.run(worker_cmd(mode, directory, out, ranks, stop_after),
+                          env=dict(ENV, RC_WORKER_DEGREE=str(degree)),
                           capture_output=True, text=True, timeout=timeout)
     assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
     return json.loads(Path(out).read_text())
@@ -167,6 +168,65 @@ def test_resume_on_another_number_of_ranks(tmp_path, written, resumed):
         for key, (s, q) in theirs.items():
             np.testing.assert_allclose(mine[key][0], s, rtol=0, atol=1e-10 * umax)
             np.testing.assert_allclose(mine[key][1], q, rtol=0, atol=1e-10 * umax ** 2)
+
+
+@pytest.mark.skipif(MPIRUN is None, reason="needs mpirun")
+@pytest.mark.parametrize("written, resumed", [(2, 1), (1, 2)])
+def test_p2_on_an_affine_mesh_resumes_on_another_number_of_ranks(tmp_path, written, resumed):
+    """P2 on an affine tetrahedral mesh: the midside nodes are not geometry nodes and are keyed
+    by their edge's end vertices (``compat.node_keys``); the rough-law program stopped after 9
+    increments on one number of ranks and resumed on the other ends with the uninterrupted
+    run's dissipation, contact force and displacement norms to 1e-10."""
+    reference = _run("full", tmp_path / "unused", tmp_path / "full.json", ranks=resumed,
+                     degree=2)
+    directory = tmp_path / "ck"
+    stopped = _run("checkpointed", directory, tmp_path / "stopped.json", ranks=written,
+                   stop_after=9, degree=2)
+    assert stopped["step"] == 9 and stopped["D"] > 0.0
+    meta = json.loads(next(directory.glob("slot*/meta.json")).read_text())
+    assert meta["keyed"] and meta["signature"]["ranks"] == written
+    got = _run("resume", directory, tmp_path / "resumed.json", ranks=resumed, degree=2)
+    assert got["first"] == 10 and got["step"] == reference["step"]
+    for key in ("D", "unorm", "umax"):
+        assert got[key] == pytest.approx(reference[key], rel=1e-10), key
+    np.testing.assert_allclose(got["F"], reference["F"], rtol=1e-10,
+                               atol=1e-10 * np.abs(reference["F"]).max())
+
+
+def _mindlin(mode, directory, out, ranks):
+    worker = Path(__file__).with_name("mindlin_worker.py")
+    proc = subprocess.run([MPIRUN, "-n", str(ranks), sys.executable, str(worker), mode,
+                           str(directory), str(out)], env=ENV, capture_output=True, text=True,
+                          timeout=600)
+    assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
+    return json.loads(Path(out).read_text())
+
+
+@pytest.mark.skipif(MPIRUN is None, reason="needs mpirun")
+@pytest.mark.parametrize("written, resumed", [(1, 2), (2, 1)])
+def test_mindlin_p2_resume_on_another_number_of_ranks(tmp_path, written, resumed):
+    """The Mindlin scene (P2 on its quadratic geometry, nodal dual points, exact stick: the
+    multipliers and the predictor's state are in the checkpoint) stopped after 3 increments on
+    one number of ranks and continued on the other ends with the uninterrupted run's rows (on
+    the resuming number of ranks) and gathered tractions to 1e-9: how a long Mindlin–Deresiewicz
+    run moves from one rank to two."""
+    directory = tmp_path / "ck"
+    full = _mindlin("full", directory, tmp_path / "full.json", resumed)
+    _mindlin("stopped", directory, tmp_path / "stopped.json", written)
+    meta = json.loads(next(directory.glob("slot*/meta.json")).read_text())
+    assert meta["keyed"] and meta["signature"]["ranks"] == written
+    got = _mindlin("resume", directory, tmp_path / "resumed.json", resumed)
+    assert len(got["t"]) == len(full["t"]) == 6 and full["dissipation"][-1] > 0.0
+    for key in ("t", "slide", "P", "Q", "dissipation", "stick", "contact_area"):
+        ref = np.asarray(full[key])
+        np.testing.assert_allclose(got[key], ref, rtol=0, atol=1e-9 * np.abs(ref).max(),
+                                   err_msg=key)
+    np.testing.assert_allclose(got["x"], full["x"], rtol=0, atol=1e-14)
+    for key in ("pressure", "shear"):
+        ref = np.asarray(full[key])
+        np.testing.assert_allclose(got[key], ref, rtol=0, atol=1e-9 * np.abs(ref).max(),
+                                   err_msg=key)
+    assert got["slipping"] == full["slipping"]
 
 
 @pytest.mark.skipif(MPIRUN is None, reason="needs mpirun")

@@ -39,7 +39,7 @@ _NORMAL = {}
 _SCENES = {}
 
 
-def _model(mesh_size=0.5, case="b", program=None):
+def _model(mesh_size=0.5, case="b", program=None, degree=1):
     comm = MPI.COMM_WORLD
     # built once per size: a second build of a mesh may be partitioned differently on 2 ranks,
     # and a checkpoint resumes only into the partition it was written from
@@ -47,7 +47,7 @@ def _model(mesh_size=0.5, case="b", program=None):
         _SCENES[mesh_size] = two_blocks(lx=2.0, ly=2.0, h1=1.0, h2=1.0, mesh_size=mesh_size,
                                         order=1)
     scene = _SCENES[mesh_size]
-    V = compat.vector_space(scene.mesh, 1)
+    V = compat.vector_space(scene.mesh, degree)
     clamp = fem.dirichletbc(np.zeros(3, dtype=PETSc.ScalarType), fem.locate_dofs_topological(
         V, 2, scene.facet_tags.find(scene.tag("bottom"))), V)
     law, normal = flat_punch.make_law(comm, case=case, normal_law="elastic", seating_pressure=5.0,
