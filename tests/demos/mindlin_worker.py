@@ -6,21 +6,20 @@ Usage: mindlin_worker.py MODE DIR OUT.json [N]"""
 
 import json
 import sys
+from pathlib import Path
 
 from mpi4py import MPI
 
-from rough_contact.interface.enforcement import NewtonAugmentedLagrangian
-from rough_contact.scenes import mindlin
+sys.path.insert(0, str(Path(__file__).parents[1] / "fem"))
+from test_mindlin_restart import _run  # noqa: E402  (the restart test's scene and enforcement)
 
-SMALL = dict(contact_size=0.1, shear_steps=4, cycles=1, points="nodal", basis="dual",
-             k_tangential=7.5e6)
 ROWS = ("t", "slide", "P", "Q", "dissipation", "stick", "contact_area", "newton")
 
 
 def main(mode, directory, out, stop_after=None):
     kwargs = {"full": {}, "stopped": dict(checkpoint=directory, stop_after=int(stop_after or 3)),
               "resume": dict(checkpoint=directory, restart=directory)}[mode]
-    run = mindlin.run(enforcement=NewtonAugmentedLagrangian(1e-4, 60), **SMALL, **kwargs)
+    run = _run(**kwargs)
     if MPI.COMM_WORLD.rank == 0:
         result = {key: [float(v) for v in getattr(run, key)] for key in ROWS}
         result.update(x=run.points.x.tolist(), pressure=run.points.pressure.tolist(),

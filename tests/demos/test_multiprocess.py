@@ -44,12 +44,16 @@ ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIR
            OPENBLAS_NUM_THREADS="1")
 
 
-def _run(mode, directory, out, timeout=600, ranks=2, stop_after=None, degree=1):
-    proc = subprocess.run(worker_cmd(mode, directory, out, ranks, stop_after),
-                          env=dict(ENV, RC_WORKER_DEGREE=str(degree)),
-                          capture_output=True, text=True, timeout=timeout)
+def _figures(cmd, out, env=ENV, timeout=600):
+    """Run a worker command; the figures it wrote as JSON into ``out``."""
+    proc = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=timeout)
     assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
     return json.loads(Path(out).read_text())
+
+
+def _run(mode, directory, out, timeout=600, ranks=2, stop_after=None, degree=1):
+    return _figures(worker_cmd(mode, directory, out, ranks, stop_after), out,
+                    env=dict(ENV, RC_WORKER_DEGREE=str(degree)), timeout=timeout)
 
 
 def _same_output(run, ref, n_steps):
@@ -195,11 +199,8 @@ def test_p2_on_an_affine_mesh_resumes_on_another_number_of_ranks(tmp_path, writt
 
 def _mindlin(mode, directory, out, ranks):
     worker = Path(__file__).with_name("mindlin_worker.py")
-    proc = subprocess.run([MPIRUN, "-n", str(ranks), sys.executable, str(worker), mode,
-                           str(directory), str(out)], env=ENV, capture_output=True, text=True,
-                          timeout=600)
-    assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
-    return json.loads(Path(out).read_text())
+    return _figures([MPIRUN, "-n", str(ranks), sys.executable, str(worker), mode,
+                     str(directory), str(out)], out)
 
 
 @pytest.mark.skipif(MPIRUN is None, reason="needs mpirun")
