@@ -193,8 +193,10 @@ def energy(levels, amplitudes, kt=None, kt_scale=None, ring_size=None, ring_band
                 # one directory per run; an existing checkpoint there is continued (the time
                 # columns are then this call's only)
                 pre = scene.get("preload_steps", 2)
+                closure = scene.get("first_contact", "increment_start") == "closure"
                 ckpt = os.path.join(ckpt_root, f"h{h:g}_amp{amp:g}"
-                                    + (f"_p{pre}" if pre != 2 else ""))
+                                    + (f"_p{pre}" if pre != 2 else "")
+                                    + ("_closure" if closure else ""))
                 scene["checkpoint"] = ckpt
                 scene["restart"] = ckpt if has_checkpoint(ckpt) else None
                 if scene["restart"] is not None:
@@ -298,6 +300,13 @@ def main(argv=None):
                     "of the edge vertices under the normal load alone grows with the "
                     "increment: at nu = 0.49 2 increments leave an edge annulus slipping, "
                     "docs/mindlin_dual.md)")
+    ap.add_argument("--first-contact", default="increment_start",
+                    choices=["increment_start", "closure"],
+                    help="energy: where a vertex that closes during an increment starts to "
+                    "stick (SoftplusPenalty(first_contact=)): at the increment's start (the "
+                    "default, the runs of sessions 12-19) or where it is at its end; with "
+                    "'closure' no vertex in contact slips under the normal load alone "
+                    "(docs/mindlin_dual.md, session 20)")
     ap.add_argument("--points", default="quadrature", choices=["quadrature", "nodal"])
     ap.add_argument("--basis", default="standard", choices=["standard", "dual"])
     ap.add_argument("--exact", action="store_true",
@@ -311,7 +320,8 @@ def main(argv=None):
                     "Newton iterations, the same fixed point")
     ap.add_argument("--checkpoint", default=None, metavar="DIR",
                     help="energy: a checkpoint per increment in DIR/h<h>_amp<amplitude> "
-                    "(_p<N> appended for --preload-steps N other than 2); a run "
+                    "(_p<N> appended for --preload-steps N other than 2, _closure for "
+                    "--first-contact closure); a run "
                     "whose directory holds one continues from it (a killed run loses no "
                     "converged increment; CPU and time columns then cover this call only)")
     ap.add_argument("--stop-after", type=int, default=None, metavar="N",
@@ -337,7 +347,8 @@ def main(argv=None):
     if args.part in ("energy", "all"):
         scene = dict(half_width=args.half_width, height=args.height,
                      mesh_size=args.mesh_size, transition=args.transition,
-                     points=args.points, basis=args.basis, preload_steps=args.preload_steps)
+                     points=args.points, basis=args.basis, preload_steps=args.preload_steps,
+                     first_contact=args.first_contact)
         if args.exact:
             scene["enforcement"] = NewtonAugmentedLagrangian(args.al_tol, 60)
         elif args.local_penalty:

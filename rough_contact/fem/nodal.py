@@ -581,10 +581,11 @@ class NodalContactInterface(ContactInterface):
         b.assemblyBegin()
         b.assemblyEnd()
         dslip = np.abs(ac.plastic_slip - committed.plastic_slip)
+        contact = ac.contact & (t[:, 0] < 0.0)
         state = InterfaceState(ac.plastic_slip, committed.accumulated_slip + dslip,
                                committed.slip_path + np.linalg.norm(
-                                   ac.plastic_slip - committed.plastic_slip, axis=1))
-        contact = ac.contact & (t[:, 0] < 0.0)
+                                   ac.plastic_slip - committed.plastic_slip, axis=1),
+                               closed=contact)
         res = LawResult(traction=t, tangent=np.zeros((t.shape[0], 3, 3)), state=state,
                         dissipation=ac.dissipation, area_fraction=contact.astype(float),
                         contact=contact, slipping=ac.slipping & contact)

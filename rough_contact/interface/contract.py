@@ -270,11 +270,14 @@ class CoulombLimit:
     Attributes:
         friction: Coulomb's mu >= 0 (0: frictionless) [-].
         k_normal, k_tangential: the law's penalties [MPa/mm] (k_tangential 0: frictionless).
+        first_contact: where a point that closes during an increment starts to stick
+            (``SoftplusPenalty``: ``"increment_start"`` or ``"closure"``).
     """
 
     friction: float
     k_normal: float
     k_tangential: float
+    first_contact: str = "increment_start"
 
 
 @runtime_checkable

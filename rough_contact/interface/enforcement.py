@@ -288,6 +288,13 @@ class SemismoothNewton:
                 f"friction exactly and needs a law with that limit (rough_contact.interface."
                 f"contract.CoulombContactLaw: coulomb_limit, e.g. SoftplusPenalty); "
                 f"{type(law).__name__} is not one (for the rough law use AugmentedLagrangian)")
+        first = law.coulomb_limit().first_contact
+        if first != "increment_start":
+            raise ValueError(
+                f"first_contact = {first!r} is not available with the semismooth Newton "
+                f"enforcement (its condensed friction anchors a closing point at the "
+                f"increment's start): use first_contact='increment_start' or "
+                f"NewtonAugmentedLagrangian")
 
     def initial_multipliers(self, n_points: int) -> None:
         """No multipliers: the tractions are condensed."""

@@ -73,10 +73,12 @@ class LinearPenalty:
         tangent[:, 1, 1] = kt
         tangent[:, 2, 2] = kt
         contact = -traction[:, 0] > 0.0
+        state = committed.copy()
+        state.closed = contact
         return LawResult(
             traction=traction,
             tangent=tangent,
-            state=committed.copy(),
+            state=state,
             dissipation=np.zeros(n),
             area_fraction=contact.astype(float),
             contact=contact,
@@ -122,6 +124,25 @@ class SoftplusPenalty:
     slips only plastically, so the result no longer depends on k_N, k_T (docs/coulomb.md); the
     penalty sets only how fast the multipliers converge.
 
+    Where a point that closes during an increment starts to stick (``first_contact``): the
+    predictor's s_p is the committed plastic slip, and a point that was open at the last commit
+    followed the other surface freely, so its s_p is where it was at the increment's start.
+    With ``"increment_start"`` (the default; the incremental slip of GetFEM's and MOOSE's
+    contact) it therefore sticks there, and its stick traction carries the tangential motion of
+    the whole increment, the part from before it touched included. Right for a point that
+    arrives while the surfaces slide (it slips at once, with mu p). With ``"closure"`` (the
+    node-to-segment convention of first contact) a point open at the last commit
+    (``InterfaceState.closed`` False: its pressure was below k_N w ln 2, the smoothed law's
+    pressure at zero gap) starts to stick where it is at the end of the increment it closes
+    in: its predictor has no elastic part in that increment, tau = lambda_T (0 without
+    multipliers), and its tangent has no tangential stiffness. Right for points that close by
+    approach, as under an indenter: without it, the vertices that close late in an increment,
+    those at the contact's edge where mu p is smallest, are held where they were before they
+    touched, and on a fine mesh they slip under a normal load alone (docs/mindlin_dual.md,
+    session 20). A point that arrives while the surfaces slide carries no friction in the
+    increment it arrives in. The virgin state counts as open, so with ``"closure"`` surfaces in
+    contact from the start carry no friction in the first increment either.
+
     Args:
         k_normal: normal stiffness k_N > 0 [MPa/mm].
         width: smoothing length w > 0 [mm].
@@ -130,6 +151,8 @@ class SoftplusPenalty:
         reversal_stiffness: factor >= 0 [-] of the secant stiffness added along m at points
             whose slip direction reversed between two Jacobians (Newton steps only, see
             above; 0 = off).
+        first_contact: ``"increment_start"`` or ``"closure"``: where a point that closes
+            during an increment starts to stick (above).
     """
 
     k_normal: float
@@ -137,6 +160,9 @@ class SoftplusPenalty:
     k_tangential: float = 0.0
     friction: float = 0.0
     reversal_stiffness: float = 1.0
+    first_contact: str = "increment_start"
+
+    FIRST_CONTACT = ("increment_start", "closure")
 
     def __post_init__(self) -> None:
         check_scalar("k_normal", self.k_normal, lo=0.0, unit="MPa/mm")
@@ -144,6 +170,9 @@ class SoftplusPenalty:
         check_scalar("k_tangential", self.k_tangential, lo=0.0, lo_open=False, unit="MPa/mm")
         check_scalar("friction", self.friction, lo=0.0, lo_open=False)
         check_scalar("reversal_stiffness", self.reversal_stiffness, lo=0.0, lo_open=False)
+        if self.first_contact not in self.FIRST_CONTACT:
+            raise ValueError(f"first_contact = {self.first_contact!r} is invalid: one of "
+                             f"{self.FIRST_CONTACT}")
 
     def initial_state(self, n_pts: int) -> InterfaceState:
         """Virgin history (no plastic slip) at n_pts points."""
@@ -190,15 +219,36 @@ class SoftplusPenalty:
         return lam[:, 0] / self.k_normal, lam[:, 1:]
 
     @staticmethod
-    def _trial_traction(jump: np.ndarray, committed: InterfaceState, lam_t, kt) -> np.ndarray:
+    def _trial_traction(jump: np.ndarray, plastic_slip: np.ndarray, lam_t, kt) -> np.ndarray:
         """Elastic predictor tau = lambda_T + k_T (s - s_p) (n, 2) [MPa] (k_T (n,))."""
-        return lam_t + kt[:, None] * (jump[:, 1:] - committed.plastic_slip)
+        return lam_t + kt[:, None] * (jump[:, 1:] - plastic_slip)
+
+    def _anchor(self, jump: np.ndarray, committed: InterfaceState
+                ) -> tuple[np.ndarray, Optional[np.ndarray]]:
+        """(s_p the predictor starts from (n, 2), the points that closed since the commit
+        (n,) bool or None): with ``first_contact="closure"`` a point open at the commit starts
+        from its current tangential jump, else from the committed plastic slip."""
+        if self.first_contact != "closure":
+            return committed.plastic_slip, None
+        fresh = ~committed.closed
+        if not fresh.any():
+            return committed.plastic_slip, None
+        sp = committed.plastic_slip.copy()
+        sp[fresh] = jump[fresh, 1:]
+        return sp, fresh
+
+    def closing_pressure(self) -> float:
+        """k_N w ln 2 [MPa]: the pressure at zero gap, above which a point counts as closed
+        (``InterfaceState.closed``); unchanged by :meth:`softened` and ``stiffness_factor``."""
+        return float(self.k_normal * self.width * np.log(2.0))
 
     def coulomb_limit(self) -> CoulombLimit:
-        """Signorini contact with Coulomb's mu (0 without tangential stiffness) and this law's
-        penalties (``rough_contact.interface.contract.CoulombContactLaw``)."""
+        """Signorini contact with Coulomb's mu (0 without tangential stiffness), this law's
+        penalties and its ``first_contact``
+        (``rough_contact.interface.contract.CoulombContactLaw``)."""
         mu = float(self.friction) if self.k_tangential > 0.0 else 0.0
-        return CoulombLimit(mu, float(self.k_normal), float(self.k_tangential))
+        return CoulombLimit(mu, float(self.k_normal), float(self.k_tangential),
+                            self.first_contact)
 
     def max_friction_coefficient(self) -> float:
         """mu (0 without tangential stiffness): |t_T| <= mu p
@@ -236,11 +286,15 @@ class SoftplusPenalty:
         traction[:, 0] = -p
         tangent[:, 0, 0] = k
         state = committed.copy()
+        state.closed = p >= self.closing_pressure()
         dissipation = np.zeros(n)
         slipping = np.zeros(n, dtype=bool)
         if self.k_tangential > 0.0:
             kt = self._kt(n, tangential_factor)
-            tau = self._trial_traction(jump, committed, lam_t, kt)
+            sp, fresh = self._anchor(jump, committed)
+            if fresh is not None:
+                state.plastic_slip[fresh] = sp[fresh]
+            tau = self._trial_traction(jump, sp, lam_t, kt)
             norm = np.linalg.norm(tau, axis=1)
             limit = self.friction * p
             # a relative margin keeps points exactly on the cone (e.g. re-evaluated after a
@@ -266,6 +320,9 @@ class SoftplusPenalty:
                 state.accumulated_slip[ret] += np.abs(dslip)
                 state.slip_path[ret] += (ns - ls) / ktr
                 dissipation[ret] = np.einsum("ij,ij->i", traction[ret, 1:], dslip)
+            if fresh is not None:
+                # s_p moves with s at a point closing in this increment: no tangential stiffness
+                tangent[fresh, 1:, 1:] = 0.0
             # a point out of contact (p = 0: zero limit, zero traction) follows the other
             # surface freely; it is open, not slipping (the counters count slip in contact)
             slipping = ret & (p > 0.0)
@@ -304,7 +361,8 @@ class SoftplusPenalty:
         if self.k_tangential <= 0.0:
             return result.tangent, None
         kt = self._kt(jump.shape[0], tangential_factor)
-        tau = self._trial_traction(jump, committed, self._shifts(multipliers)[1], kt)
+        tau = self._trial_traction(jump, self._anchor(jump, committed)[0],
+                                   self._shifts(multipliers)[1], kt)
         norm = np.linalg.norm(tau, axis=1)
         m = np.divide(tau, norm[:, None], out=np.zeros_like(tau), where=norm[:, None] > 0.0)
         tangent = result.tangent

@@ -11,7 +11,7 @@ the dissipation increment of a step; ``StatePair`` is where it is summed.
 from __future__ import annotations
 
 import dataclasses
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Optional, Sequence
 
 import numpy as np
@@ -31,21 +31,33 @@ class InterfaceState:
         accumulated_slip: (n, 2) sums of |Delta s_p,x| and |Delta s_p,y| [mm]; hardening
             variables of the orthotropic law, (89)-(90).
         slip_path: (n,) sum of ||Delta s_p|| [mm]; hardening variable of the isotropic law (119).
+        closed: (n,) bool, the point was in contact when this state was reached, as the law
+            that wrote the state judged it (``SoftplusPenalty``: pressure at least that of its
+            smoothing at zero gap; ``LinearPenalty``: pressure > 0); a law that does not
+            record it passes it on unchanged. Keyword only; default (None): all open, the
+            virgin state. ``SoftplusPenalty(first_contact="closure")`` reads it to find the
+            points that close during an increment.
     """
 
     plastic_slip: np.ndarray
     accumulated_slip: np.ndarray
     slip_path: np.ndarray
+    closed: Optional[np.ndarray] = field(default=None, kw_only=True)
 
     def __post_init__(self) -> None:
         n = np.shape(self.plastic_slip)[0] if np.ndim(self.plastic_slip) == 2 else -1
+        if self.closed is None and n >= 0:
+            self.closed = np.zeros(n, dtype=bool)
         for name, shape in (("plastic_slip", (n, 2)), ("accumulated_slip", (n, 2)),
-                            ("slip_path", (n,))):
+                            ("slip_path", (n,)), ("closed", (n,))):
             arr = getattr(self, name)
             if not isinstance(arr, np.ndarray) or arr.shape != shape or n < 0:
                 want = shape if n >= 0 else "(n, 2)"
                 raise ValueError(f"InterfaceState.{name} must be an ndarray of shape {want}, "
                                  f"got {np.shape(arr)}")
+        if self.closed.dtype != bool:
+            raise ValueError(f"InterfaceState.closed must be a bool array, got dtype "
+                             f"{self.closed.dtype}")
 
     @classmethod
     def zeros(cls, n_pts: int) -> InterfaceState:
@@ -58,7 +70,13 @@ class InterfaceState:
     def copy(self) -> InterfaceState:
         """Deep copy."""
         return InterfaceState(self.plastic_slip.copy(), self.accumulated_slip.copy(),
-                              self.slip_path.copy())
+                              self.slip_path.copy(), closed=self.closed.copy())
+
+    def __setstate__(self, state: dict) -> None:
+        # a state pickled before ``closed`` existed (an older checkpoint): all open
+        self.__dict__.update(state)
+        if self.__dict__.get("closed") is None:
+            self.closed = np.zeros(len(self.slip_path), dtype=bool)
 
     def __len__(self) -> int:
         return self.plastic_slip.shape[0]
@@ -92,7 +110,8 @@ class HistoryInterfaceState(InterfaceState):
     def copy(self) -> HistoryInterfaceState:
         """Deep copy."""
         return HistoryInterfaceState(self.plastic_slip.copy(), self.accumulated_slip.copy(),
-                                     self.slip_path.copy(), self.h_min.copy())
+                                     self.slip_path.copy(), self.h_min.copy(),
+                                     closed=self.closed.copy())
 
 
 class StatePair:
