@@ -94,3 +94,46 @@ def edge_bands(points, i, a, edges):
     bands = [(lo, hi, on & (rad >= lo * a) & (rad < hi * a))
              for lo, hi in zip(edges[:-1], edges[1:])]
     return [b for b in bands if b[2].any()], t_r, t_h
+
+
+PROFILE_EDGES = (0.0, 0.5, 0.7, 0.8, 0.9, 0.95, 0.97, 0.98, 0.99, 1.0, 1.01)
+"""Bands of r / a_Hertz of :func:`normal_load_profile`."""
+
+
+def spence_profile(beta_over_mu, edges=PROFILE_EDGES, rings=400):
+    """The continuum's shear under the normal load alone (Spence's problem,
+    ``rough_contact.frictional_hertz.slip_annulus``) per band [lo, hi) of r / a: (mean radial
+    shear / mu p0, largest q / (mu p)) for each band inside the contact (nan beyond a)."""
+    import numpy as np
+    from rough_contact.frictional_hertz import slip_annulus
+    s = slip_annulus(beta_over_mu, rings=rings)
+    out = []
+    for lo, hi in zip(edges[:-1], edges[1:]):
+        m = (s.r >= lo) & (s.r < min(hi, 1.0))
+        if not m.any():
+            out.append((float("nan"), float("nan")))
+            continue
+        out.append((float(s.shear[m].mean()), float((s.shear[m] / s.pressure[m]).max())))
+    return out
+
+
+def normal_load_profile(points, i, a, mu, beta_over_mu, edges=PROFILE_EDGES):
+    """Lines of a table of the shear at increment ``i`` of a Mindlin run's gathered points
+    (``rough_contact.scenes.mindlin.PointSnapshot``) per band of r / ``a`` (Hertz's radius):
+    vertices in contact, slipping ones, the mean radial shear (outwards on the block positive)
+    / mu p0 and the largest |t| / (mu p), against the continuum's (:func:`spence_profile`);
+    p0: the largest pressure of the increment."""
+    import numpy as np
+    p = points.pressure[i]
+    mu_p0 = mu * p.max()
+    bands, t_r, _ = edge_bands(points, i, a, edges)
+    ratio = np.linalg.norm(points.shear[i], axis=1) / np.maximum(mu * p, 1e-300)
+    cont = dict(zip(zip(edges[:-1], edges[1:]), spence_profile(beta_over_mu, edges)))
+    lines = [f"  {'r/a_H':>10} {'contact':>7} {'slip':>5} {'t_r/mu p0':>9} {'Spence':>7} "
+             f"{'max|t|/mu p':>11} {'Spence':>7}"]
+    for lo, hi, m in bands:
+        c_mean, c_max = cont[(lo, hi)]
+        lines.append(f"  {lo:4.2f}-{hi:4.2f} {int(m.sum()):7d} "
+                     f"{int((points.slipping[i] & m).sum()):5d} {t_r[m].mean() / mu_p0:+9.4f} "
+                     f"{c_mean:+7.4f} {ratio[m].max():11.3f} {c_max:7.3f}")
+    return lines

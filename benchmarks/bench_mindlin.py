@@ -32,8 +32,9 @@ from dataclasses import replace
 import numpy as np
 from petsc4py import PETSc
 
-from _common import edge_bands
+from _common import normal_load_profile
 from rough_contact import references
+from rough_contact.frictional_hertz import coupling_parameter
 from rough_contact.interface.enforcement import NewtonAugmentedLagrangian
 from rough_contact.solver.checkpoint import has_checkpoint
 from rough_contact.scenes import mindlin
@@ -247,14 +248,11 @@ def first_loading(r):
     PETSc.Sys.Print(f"  normal load alone: {int(slip0.sum())} of "
                     f"{int(r.points.contact[i0].sum())} points in contact slip, the innermost "
                     f"at r / a_Hertz = {inner:.4f}")
-    # where they are: per band of r / a_Hertz, the mean radial shear (outwards on the block
-    # positive) over mu p0 and the slipping points
-    mu_p0 = r.mu * r.points.pressure[i0].max()
-    bands, t_r, _ = edge_bands(r.points, i0, r.a, (0.9, 0.95, 0.97, 0.98, 0.99, 1.0, 1.01))
-    cells = [f"{lo:g}-{hi:g}: {t_r[m].mean() / mu_p0:+.3f} ({int(slip0[m].sum())})"
-             for lo, hi, m in bands]
-    PETSc.Sys.Print("  mean radial shear / mu p0 (slipping points) by r / a_Hertz: "
-                    + ", ".join(cells))
+    # where they are: per band of r / a_Hertz, the slipping points, the mean radial shear
+    # (outwards on the block positive) / mu p0 and the largest |t| / mu p, against the
+    # continuum's (Spence's problem at this beta / mu)
+    beta_mu = abs(coupling_parameter(np.inf, 0.3, E, NU)) / r.mu
+    PETSc.Sys.Print("\n".join(normal_load_profile(r.points, i0, r.a, r.mu, beta_mu)))
     PETSc.Sys.Print(f"  {'Q/muP':>7} {'c/a FE':>7} {'inside':>7} {'c/a CM':>7} {'error':>7} "
                     f"{'in err':>7}")
     for i in range(i0, i1 + 1):

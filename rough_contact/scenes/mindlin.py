@@ -48,7 +48,8 @@ from rough_contact.solver.snes import SNESSolver
 from rough_contact.stick_front import contact_front, stick_front
 from rough_contact.validation import check_integer, check_scalar
 
-__all__ = ["ParaboloidIndenter", "KT_SCALE", "MindlinRun", "PointSnapshot", "run"]
+__all__ = ["ParaboloidIndenter", "KT_SCALE", "MindlinRun", "PointSnapshot", "run",
+           "checkpointed_points"]
 
 
 class ParaboloidIndenter:
@@ -195,6 +196,25 @@ def _gather_points(comm, x, arrays):
     key = np.round(xs / max(float(np.abs(xs).max(initial=0.0)), 1e-300), 9)
     order = np.lexsort((key[:, 2], key[:, 1], key[:, 0]))
     return xs[order], data[order]
+
+
+def _snapshot(snaps, x_near) -> PointSnapshot:
+    """The :class:`PointSnapshot` of a record's per-increment point arrays (columns: weight,
+    p, t_x, t_y, slipping, contact)."""
+    S = np.array(snaps)
+    on_all = S[:, :, 5] > 0.5
+    return PointSnapshot(x=x_near, weight=S[0, :, 0], pressure=S[:, :, 1], shear=S[:, :, 2:4],
+                         contact=on_all, slipping=on_all & (S[:, :, 4] > 0.5))
+
+
+def checkpointed_points(directory: str) -> tuple[np.ndarray, np.ndarray, PointSnapshot]:
+    """(t, P [N], points) of the increments a checkpointed :func:`run` has done, read from
+    its checkpoint ``directory`` without resuming it (serial, no FE set-up):
+    ``rough_contact.solver.checkpoint.saved_outputs``. ``points`` as ``MindlinRun.points``."""
+    from rough_contact.solver.checkpoint import saved_outputs
+    rows, snaps, x_near = saved_outputs(directory)[0]
+    t, _, P = (np.array(c) for c in list(zip(*rows))[:3])
+    return t, P, _snapshot(snaps, x_near)
 
 
 class _Record:
@@ -413,10 +433,7 @@ def run(contact_size=0.05, order=2, radius=10.0, delta=4e-3, slide=None, E=2.0e5
     rows, snaps, x_near = record.rows, record.snaps, record.x_near
     t, s, P, Q, stick, area, D, newton, front, c_r, a_r, res, mis, front_in = \
         (np.array(c) for c in zip(*rows))
-    S = np.array(snaps)
-    on_all = S[:, :, 5] > 0.5
-    points = PointSnapshot(x=x_near, weight=S[0, :, 0], pressure=S[:, :, 1], shear=S[:, :, 2:4],
-                           contact=on_all, slipping=on_all & (S[:, :, 4] > 0.5))
+    points = _snapshot(snaps, x_near)
     return MindlinRun(t=t, slide=s, P=P, Q=Q, stick=stick, contact_area=area, dissipation=D,
                       newton=newton, a=hertz_radius(P[-1], radius, E_star), G=G, nu=nu, mu=mu,
                       dofs=problem.num_dofs, cycle_start=prog.cycle_start,

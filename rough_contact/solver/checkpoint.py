@@ -61,7 +61,8 @@ from mpi4py import MPI
 from rough_contact.fingerprint import differences
 from rough_contact.interface.state import is_pointwise, take_points
 
-__all__ = ["ResumableOutput", "CheckpointState", "has_checkpoint", "CheckpointError", "signature",
+__all__ = ["ResumableOutput", "CheckpointState", "has_checkpoint", "saved_outputs",
+           "CheckpointError", "signature",
            "write_checkpoint", "read_checkpoint", "FORMAT"]
 
 FORMAT = 2     # 2: state by partition-independent keys, the problem's fingerprint
@@ -177,6 +178,22 @@ def write_checkpoint(directory: str, problem, state: CheckpointState, sig: dict,
 def has_checkpoint(directory: str, comm: MPI.Comm = MPI.COMM_WORLD) -> bool:
     """Whether ``directory`` holds a complete checkpoint (collective: rank 0 decides)."""
     return bool(comm.bcast(_latest(directory) is not None if comm.rank == 0 else None, root=0))
+
+
+def saved_outputs(directory: str) -> list:
+    """The states of the outputs saved with the latest checkpoint in ``directory``
+    (``ResumableOutput.checkpoint_state``, in the order the run passed them), as rank 0 wrote
+    them; a plain file read, no communicator: for outputs that are the same on every rank
+    (e.g. the Mindlin scene's per-increment record), to inspect a run without resuming it.
+
+    Raises:
+        CheckpointError: ``directory`` holds no complete checkpoint.
+    """
+    slot = _latest(directory)
+    if slot is None:
+        raise CheckpointError(f"directory {directory!r} holds no complete checkpoint (no LATEST)")
+    with open(os.path.join(directory, slot, "rank0.pkl"), "rb") as f:
+        return pickle.load(f)["outputs"]
 
 
 def _local_checksum(problem) -> np.ndarray:

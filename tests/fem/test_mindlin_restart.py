@@ -17,6 +17,7 @@ from mpi4py import MPI
 
 from rough_contact.interface.enforcement import NewtonAugmentedLagrangian
 from rough_contact.scenes import mindlin
+from rough_contact.solver.checkpoint import CheckpointError
 
 SMALL = dict(contact_size=0.1, shear_steps=4, cycles=1, points="nodal", basis="dual",
              k_tangential=7.5e6)
@@ -56,5 +57,13 @@ def test_a_finished_run_is_read_back_and_bad_stop_refused(tmp_path):
     again = _run(checkpoint=ck, restart=ck)
     np.testing.assert_array_equal(again.Q, full.Q)
     np.testing.assert_array_equal(again.newton, full.newton)
+    # the record read from the checkpoint without resuming (benchmarks/bench_normal_load_slip.py)
+    t, P, pts = mindlin.checkpointed_points(ck)
+    np.testing.assert_array_equal(t, full.t)
+    np.testing.assert_array_equal(P, full.P)
+    for key in ("x", "pressure", "shear", "contact", "slipping", "weight"):
+        np.testing.assert_array_equal(getattr(pts, key), getattr(full.points, key), err_msg=key)
+    with pytest.raises(CheckpointError, match="holds no complete checkpoint"):
+        mindlin.checkpointed_points(str(tmp_path / "nothing"))
     with pytest.raises(ValueError, match="stop_after = 0 is invalid"):
         _run(stop_after=0)
