@@ -96,6 +96,10 @@ def main(argv=None):
                     help="NewtonAugmentedLagrangian.residual_ratio (--enforcement newton)")
     ap.add_argument("--contact-size", type=float, default=0.05)
     ap.add_argument("--preload-steps", type=int, default=2)
+    ap.add_argument("--first-contact", default="increment_start",
+                    choices=["increment_start", "closure"],
+                    help="where a vertex that closes during an increment starts to stick "
+                    "(SoftplusPenalty(first_contact=); docs/mindlin_dual.md, session 20)")
     ap.add_argument("--shear-steps", type=int, default=6)
     ap.add_argument("--k-tangential", type=float, default=1e9,
                     help="tangential penalty [MPa/mm]; with exact stick it sets only how fast "
@@ -139,7 +143,7 @@ def main(argv=None):
                     height=args.height, mesh_size=args.mesh_size,
                     transition=args.transition, refined_radius=args.refined_radius,
                     front_band=args.front_band, width_ratio=args.width_ratio,
-                    verbose=args.verbose)
+                    first_contact=args.first_contact, verbose=args.verbose)
     E_star = E / (1.0 - args.nu**2)
     q = r.Q / (r.mu * r.P)
     PETSc.Sys.Print(f"{'t':>6} {'P [N]':>8} {'P/Hertz-1':>9} {'Q/muP':>7} {'c/a MD':>7} "
