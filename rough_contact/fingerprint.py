@@ -12,6 +12,9 @@ parameters:
 * a frozen dataclass (the house style for laws, enforcements, pairings) is
   ``{"type": module.qualname, field: description, ...}`` over its fields; a field declared
   ``field(compare=False)`` is not part of its identity and is left out (e.g. build statistics);
+  a field declared with ``metadata={FINGERPRINT_ADDED: True}`` (added to the class after
+  checkpoints of it existed) is left out while it holds its default, so those checkpoints,
+  which lack it, still match (``SoftplusPenalty.first_contact``);
 * an object with a ``describe()`` method (:class:`Describable`) gives its own description;
 * a function is its qualified name and the values it closes over;
 * anything else cannot be described: it is recorded by its qualified class name and a
@@ -40,9 +43,13 @@ from typing import Any, List, Protocol, runtime_checkable
 import numpy as np
 
 __all__ = ["Describable", "UndescribedWarning", "describe", "differences", "SMALL_ARRAY",
+           "FINGERPRINT_ADDED",
            "FLOAT_RTOL", "ARRAY_RTOL"]
 
 SMALL_ARRAY = 16   # arrays up to this size are written out value by value
+FINGERPRINT_ADDED = "rough_contact.fingerprint.added"
+"""Key of a dataclass field's metadata: the field was added after checkpoints of its class
+existed, and is described only when it differs from its default (module docstring)."""
 FLOAT_RTOL = 1e-12  # two floats closer than this (relative) are the same parameter
 ARRAY_RTOL = 1e-10  # two float arrays whose sketches agree to this (of sum |a|) are the same
 _SKETCH_SEED = 20090424
@@ -59,6 +66,14 @@ class Describable(Protocol):
     def describe(self) -> dict:
         """Plain data (dict / list / str / int / float / bool / None / ndarray, nested) that is
         equal for two objects that behave alike; :func:`describe` canonicalises it."""
+
+
+def _is_default(value, default) -> bool:
+    """Whether a field's value is its (scalar or string) default."""
+    try:
+        return bool(value == default) and type(value) is type(default)
+    except (TypeError, ValueError):
+        return False
 
 
 def _qualname(obj) -> str:
@@ -145,8 +160,12 @@ def describe(obj: Any, path: str = "") -> Any:
     if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
         out = {"type": _qualname(obj)}
         for f in dataclasses.fields(obj):
+            value = getattr(obj, f.name)
+            if f.metadata.get(FINGERPRINT_ADDED) and f.default is not dataclasses.MISSING \
+                    and _is_default(value, f.default):
+                continue
             if f.compare:
-                out[f.name] = describe(getattr(obj, f.name), f"{path}.{f.name}")
+                out[f.name] = describe(value, f"{path}.{f.name}")
         return out
     if callable(obj) and hasattr(obj, "__code__"):
         return _function(obj, path)

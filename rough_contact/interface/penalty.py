@@ -11,12 +11,13 @@ Units: mm, N, MPa. Jumps [mm]; tractions [MPa]; stiffnesses per area [MPa/mm].
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from typing import Optional
 
 import numpy as np
 from scipy.special import expit
 
+from ..fingerprint import FINGERPRINT_ADDED
 from ..validation import check_scalar
 from .contract import CoulombLimit, LawResult, check_jump, check_point_factor
 from .state import InterfaceState
@@ -160,7 +161,9 @@ class SoftplusPenalty:
     k_tangential: float = 0.0
     friction: float = 0.0
     reversal_stiffness: float = 1.0
-    first_contact: str = "increment_start"
+    # checkpoints written before first_contact existed still match at its default
+    first_contact: str = field(default="increment_start",
+                               metadata={FINGERPRINT_ADDED: True})
 
     FIRST_CONTACT = ("increment_start", "closure")
 

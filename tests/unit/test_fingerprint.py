@@ -135,3 +135,32 @@ def test_round_off_is_not_a_different_parameter():
     # a description written before sketches existed is compared by its hash alone
     old = {k: v for k, v in describe(a).items() if k != "sketch"}
     assert differences({"t": old}, describe({"t": ulp})) != []
+
+
+def test_a_field_added_later_is_described_only_away_from_its_default():
+    """A field declared with ``metadata={FINGERPRINT_ADDED: True}`` is left out at its default,
+    so a checkpoint written before the field existed matches; any other value is named."""
+    import dataclasses
+
+    from rough_contact.fingerprint import FINGERPRINT_ADDED
+
+    @dataclasses.dataclass(frozen=True)
+    class Old:
+        k: float
+
+    @dataclasses.dataclass(frozen=True)
+    class New:
+        k: float
+        mode: str = dataclasses.field(default="a", metadata={FINGERPRINT_ADDED: True})
+
+    saved = describe(Old(1.0))
+    saved["type"] = describe(New(1.0))["type"]             # the same class, an older version
+    assert "mode" not in describe(New(1.0))
+    assert differences(saved, describe(New(1.0))) == []
+    assert differences(saved, describe(New(1.0, mode="b"))) == [
+        "mode: (absent) in the checkpoint, b now"]
+    # the law that uses it: the default SoftplusPenalty describes as before the field existed
+    from rough_contact.interface.penalty import SoftplusPenalty
+    assert "first_contact" not in describe(SoftplusPenalty(1e8, 1e-7, 1e7, 0.3))
+    assert describe(SoftplusPenalty(1e8, 1e-7, 1e7, 0.3,
+                                    first_contact="closure"))["first_contact"] == "closure"
