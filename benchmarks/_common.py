@@ -4,6 +4,7 @@ first on ``sys.path``)."""
 from __future__ import annotations
 
 import csv
+import functools
 import os
 
 
@@ -100,6 +101,7 @@ PROFILE_EDGES = (0.0, 0.5, 0.7, 0.8, 0.9, 0.95, 0.97, 0.98, 0.99, 1.0, 1.01)
 """Bands of r / a_Hertz of :func:`normal_load_profile`."""
 
 
+@functools.lru_cache(maxsize=8)
 def spence_profile(beta_over_mu, edges=PROFILE_EDGES, rings=400):
     """The continuum's shear under the normal load alone (Spence's problem,
     ``rough_contact.frictional_hertz.slip_annulus``) per band [lo, hi) of r / a: (mean radial
@@ -128,7 +130,7 @@ def normal_load_profile(points, i, a, mu, beta_over_mu, edges=PROFILE_EDGES):
     mu_p0 = mu * p.max()
     bands, t_r, _ = edge_bands(points, i, a, edges)
     ratio = np.linalg.norm(points.shear[i], axis=1) / np.maximum(mu * p, 1e-300)
-    cont = dict(zip(zip(edges[:-1], edges[1:]), spence_profile(beta_over_mu, edges)))
+    cont = dict(zip(zip(edges[:-1], edges[1:]), spence_profile(beta_over_mu, tuple(edges))))
     lines = [f"  {'r/a_H':>10} {'contact':>7} {'slip':>5} {'t_r/mu p0':>9} {'Spence':>7} "
              f"{'max|t|/mu p':>11} {'Spence':>7}"]
     for lo, hi, m in bands:

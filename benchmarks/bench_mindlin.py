@@ -42,6 +42,12 @@ from rough_contact.scenes import mindlin
 E, NU, MU, R, DELTA = 2.0e5, 0.49, 0.3, 10.0, 4e-3
 
 
+def beta_over_mu(mu=MU):
+    """Dundurs' beta of the rigid indenter on this block over mu (Spence's parameter; the
+    indenter's Poisson ratio does not enter)."""
+    return abs(coupling_parameter(np.inf, 0.0, E, NU)) / mu
+
+
 def gross_slide(half_width=4.0, height=4.0):
     """The bottom slide at which Mindlin's Q reaches mu P (Hertz's P and a at DELTA) plus the
     block's shear compliance H / (G 2 L^2) times mu P."""
@@ -251,8 +257,8 @@ def first_loading(r):
     # where they are: per band of r / a_Hertz, the slipping points, the mean radial shear
     # (outwards on the block positive) / mu p0 and the largest |t| / mu p, against the
     # continuum's (Spence's problem at this beta / mu)
-    beta_mu = abs(coupling_parameter(np.inf, 0.3, E, NU)) / r.mu
-    PETSc.Sys.Print("\n".join(normal_load_profile(r.points, i0, r.a, r.mu, beta_mu)))
+    PETSc.Sys.Print("\n".join(normal_load_profile(r.points, i0, r.a, r.mu,
+                                                   beta_over_mu(r.mu))))
     PETSc.Sys.Print(f"  {'Q/muP':>7} {'c/a FE':>7} {'inside':>7} {'c/a CM':>7} {'error':>7} "
                     f"{'in err':>7}")
     for i in range(i0, i1 + 1):

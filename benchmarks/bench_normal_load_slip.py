@@ -20,11 +20,19 @@ import os
 import numpy as np
 
 from _common import normal_load_profile
-from rough_contact.frictional_hertz import coupling_parameter
+from bench_mindlin import E, MU, NU, R, beta_over_mu
 from rough_contact.references import hertz_radius
 from rough_contact.scenes import mindlin
 
-E, NU, MU, R = 2.0e5, 0.49, 0.3, 10.0           # the scene of bench_mindlin.py
+
+def _slip_line(pts, i, P):
+    """(Hertz's radius at P [mm], the summary of increment i: vertices in contact, slipping,
+    the innermost slipping one's r / a_Hertz)."""
+    a = hertz_radius(P, R, E / (1.0 - NU**2))
+    on, slip = pts.contact[i], pts.slipping[i]
+    inner = pts.r[slip].min() / a if slip.any() else float("nan")
+    return a, (f"{int(on.sum())} vertices in contact, {int(slip.sum())} slip, innermost at "
+               f"r / a_Hertz = {inner:.4f}")
 
 
 def main(argv=None):
@@ -35,18 +43,12 @@ def main(argv=None):
     ap.add_argument("--each", action="store_true",
                     help="also one line per increment of the normal load")
     args = ap.parse_args(argv)
-    beta_mu = abs(coupling_parameter(np.inf, 0.3, E, NU)) / MU
-    E_star = E / (1.0 - NU**2)
     for d in args.dirs:
         t, P, pts = mindlin.checkpointed_points(d)
         if args.each:
             for j in np.flatnonzero(t <= 1.0 + 1e-9):
-                on, slip = pts.contact[j], pts.slipping[j]
-                a_j = hertz_radius(P[j], R, E_star)
-                inner = pts.r[slip].min() / a_j if slip.any() else float("nan")
                 print(f"{os.path.basename(d)}: increment {j + 1} (t = {t[j]:g}): "
-                      f"{int(on.sum())} in contact, {int(slip.sum())} slip, innermost at "
-                      f"r / a_Hertz = {inner:.4f}")
+                      f"{_slip_line(pts, j, P[j])[1]}")
         if args.increment is None:
             done = np.flatnonzero(np.abs(t - 1.0) < 1e-9)
             if done.size == 0:
@@ -59,13 +61,10 @@ def main(argv=None):
                 raise SystemExit(f"--increment {args.increment} is invalid: the checkpoint in "
                                  f"{d} has increments 1 ... {t.size}")
             i = args.increment - 1
-        a = hertz_radius(P[i], R, E_star)
-        on, slip = pts.contact[i], pts.slipping[i]
-        inner = pts.r[slip].min() / a if slip.any() else float("nan")
+        a, line = _slip_line(pts, i, P[i])
         print(f"{os.path.basename(d)}: increment {i + 1} (t = {t[i]:g}), P = {P[i]:.4g} N, "
-              f"{int(on.sum())} vertices in contact, {int(slip.sum())} slip, innermost at "
-              f"r / a_Hertz = {inner:.4f}")
-        print("\n".join(normal_load_profile(pts, i, a, MU, beta_mu)))
+              f"{line}")
+        print("\n".join(normal_load_profile(pts, i, a, MU, beta_over_mu())))
 
 
 if __name__ == "__main__":
