@@ -49,7 +49,7 @@ from rough_contact.stick_front import contact_front, stick_front
 from rough_contact.validation import check_integer, check_scalar
 
 __all__ = ["ParaboloidIndenter", "KT_SCALE", "MindlinRun", "PointSnapshot", "run",
-           "checkpointed_points"]
+           "checkpointed_points", "checkpointed_forces"]
 
 
 class ParaboloidIndenter:
@@ -207,13 +207,22 @@ def _snapshot(snaps, x_near) -> PointSnapshot:
                          contact=on_all, slipping=on_all & (S[:, :, 4] > 0.5))
 
 
+def checkpointed_forces(directory: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(t, P, Q [N]) of the increments a checkpointed :func:`run` has done, as
+    :func:`checkpointed_points` reads them."""
+    from rough_contact.solver.checkpoint import saved_outputs
+    rows = saved_outputs(directory)[0][0]
+    t, _, P, Q = (np.array(c) for c in list(zip(*rows))[:4])
+    return t, P, Q
+
+
 def checkpointed_points(directory: str) -> tuple[np.ndarray, np.ndarray, PointSnapshot]:
     """(t, P [N], points) of the increments a checkpointed :func:`run` has done, read from
     its checkpoint ``directory`` without resuming it (serial, no FE set-up):
     ``rough_contact.solver.checkpoint.saved_outputs``. ``points`` as ``MindlinRun.points``."""
     from rough_contact.solver.checkpoint import saved_outputs
-    rows, snaps, x_near = saved_outputs(directory)[0]
-    t, _, P = (np.array(c) for c in list(zip(*rows))[:3])
+    _, snaps, x_near = saved_outputs(directory)[0]
+    t, P, _ = checkpointed_forces(directory)
     return t, P, _snapshot(snaps, x_near)
 
 
