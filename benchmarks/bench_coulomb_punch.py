@@ -15,7 +15,7 @@ relative to the largest traction (about 1 for a penalty, the tolerance for exact
         [--quadrature gauss vertex nodal] [--reversal-stiffness 0 1] [--augmented 0 1 2 3]
         [--al-tol 1e-3] [--basis standard dual] [--residual-ratio 1e-2] [--ssn-r R]
         [--continuation none 100,10] [--after 10] [--linear-solver auto mumps hypre] [--csv FILE]
-        [--mesh-size H] [--contact-size HC] [--edge-size HE] [--edge-band B]
+        [--mesh-size H] [--contact-size HC] [--edge-size HE] [--edge-band B] [--edge-growth G]
 
 Levels (P1; mesh and contact size in LEVELS): 1 ~4.5 k DOFs, 2 ~26 k, 3 ~73 k, 4 ~99 k (the size
 of GetFEM's finest run). ``--mesh-size`` (bulk element size, (0, 50] mm) and ``--contact-size``
@@ -91,9 +91,10 @@ def run(level: int, mu: float, k: float, width: float, predictor: str, quadratur
         comm=MPI.COMM_WORLD, verbose=False, reversal_stiffness=1.0, augmented=False,
         al_tol=1e-3, continuation=None, linear_solver="auto", residual_ratio=1e-2,
         basis="standard", mesh_size=None, contact_size=None, edge_size=None,
-        edge_band=None, ssn_r=None) -> dict:
+        edge_band=None, ssn_r=None, edge_growth=None) -> dict:
     mesh_size, contact_size = level_sizes(level, mesh_size, contact_size)
-    edge_size, edge_band = edge_grading(contact_size, PUNCH_HALF_WIDTH, edge_size, edge_band)
+    edge_size, edge_band = edge_grading(contact_size, PUNCH_HALF_WIDTH, edge_size, edge_band,
+                                        edge_growth=edge_growth)
     law = SoftplusPenalty(k_normal=k, width=width, k_tangential=k, friction=mu,
                           reversal_stiffness=reversal_stiffness)
     if augmented == 3:     # Alart-Curnier's semismooth Newton, tractions condensed (dual P1)
@@ -109,7 +110,7 @@ def run(level: int, mu: float, k: float, width: float, predictor: str, quadratur
                          quadrature="gauss" if quadrature == "nodal" else quadrature,
                          points="nodal" if quadrature == "nodal" else "quadrature",
                          basis=basis, enforcement=enforcement, edge_size=edge_size,
-                         edge_band=edge_band,
+                         edge_band=edge_band, edge_growth=edge_growth,
                          solver_options=dict(continuation=continuation,
                                              linear_solver=linear_solver))
     factors = load_unload_factors(N_LOAD, N_LOAD - 1, final_factor=1.0 / N_LOAD)
@@ -151,7 +152,8 @@ def run(level: int, mu: float, k: float, width: float, predictor: str, quadratur
                gap_peak=exact[0], stick_peak=exact[1],
                failed=failed,
                edge_size=float("nan") if edge_size is None else edge_size,
-               edge_band=float("nan") if edge_band is None else edge_band)
+               edge_band=float("nan") if edge_band is None else edge_band,
+               edge_growth=float("nan") if edge_growth is None else edge_growth)
     m.solver.destroy()
     return out
 
@@ -222,6 +224,10 @@ def main(argv=None):
     ap.add_argument("--edge-band", type=float, default=None,
                     help="distance from the edge within which --edge-size applies [mm]; "
                     "(0, 10], default the contact size")
+    ap.add_argument("--edge-growth", type=float, default=None,
+                    help="growth of the element size per mm beyond the edge band, (0, 1] "
+                    "(a geometric grading of ratio about 1 + growth); default twice the patch "
+                    "field's rate")
     ap.add_argument("--csv", default=None)
     ap.add_argument("--verbose", action="store_true")
     args, _petsc = ap.parse_known_args(argv)   # the rest goes to PETSc
@@ -231,7 +237,8 @@ def main(argv=None):
     for level in args.levels:     # refused before any mesh is built
         try:
             edge_grading(level_sizes(level, args.mesh_size, args.contact_size)[1],
-                         PUNCH_HALF_WIDTH, args.edge_size, args.edge_band)
+                         PUNCH_HALF_WIDTH, args.edge_size, args.edge_band,
+                         edge_growth=args.edge_growth)
         except ValueError as exc:
             ap.error(str(exc))
     rows = []
@@ -263,7 +270,7 @@ def main(argv=None):
                             residual_ratio=args.residual_ratio, basis=basis,
                             mesh_size=args.mesh_size, contact_size=args.contact_size,
                             edge_size=args.edge_size, edge_band=args.edge_band,
-                            ssn_r=args.ssn_r)
+                            ssn_r=args.ssn_r, edge_growth=args.edge_growth)
                     rows.append(r)
                     label = pred + "/" + quad[0] + ("*" if basis == "dual" else "")
                     PETSc.Sys.Print(

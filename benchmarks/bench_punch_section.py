@@ -36,12 +36,9 @@ import numpy as np  # noqa: E402
 from mpi4py import MPI  # noqa: E402
 from petsc4py import PETSc  # noqa: E402
 
-from rough_contact.fem.boundary import fix  # noqa: E402
-from rough_contact.fem.compat import vector_space  # noqa: E402
 from rough_contact.interface.enforcement import NewtonAugmentedLagrangian, Penalty  # noqa: E402
 from rough_contact.interface.penalty import SoftplusPenalty  # noqa: E402
 from rough_contact.scenes import flat_punch  # noqa: E402
-from rough_contact.scenes.meshes.punch_section import punch_section  # noqa: E402
 from rough_contact.solver.loading import load_path, load_unload_factors  # noqa: E402
 
 A = 10.0            # punch half width [mm]
@@ -53,15 +50,12 @@ BONDED_RATIO = 0.5431   # |tau / sigma| of the first Williams mode on the interf
 def section_model(comm, mu, k, mesh_size, contact_size, edge_size, edge_growth, exact=True,
                   al_tol=1e-4, thickness=1.0):
     """The section's model (flat_punch.PunchModel) with the Coulomb law, exact or penalty."""
-    scene = punch_section(mesh_size=mesh_size, contact_size=contact_size, edge_size=edge_size,
-                          edge_growth=edge_growth, half_width=A, thickness=thickness, comm=comm)
-    V = vector_space(scene.mesh, 1)
-    ft = scene.facet_tags
-    bcs = [fix(V, ft, scene.tag("symmetry_x"), 0), fix(V, ft, scene.tag("plane"), 1),
-           fix(V, ft, scene.tag("fixed"))]
+    section = flat_punch.punch_section_scene(comm, mesh_size=mesh_size,
+                                            contact_size=contact_size, edge_size=edge_size,
+                                            edge_growth=edge_growth, thickness=thickness)
     law = SoftplusPenalty(k_normal=k, width=1e-2 * PRESSURE / k, k_tangential=k, friction=mu)
     return flat_punch.build(
-        comm, law=law, steps=N_LOAD, punch_scene=flat_punch.PunchScene(scene, V, bcs),
+        comm, law=law, steps=N_LOAD, punch_scene=section,
         total_force=4 * PRESSURE * A * thickness,     # build() loads a quarter of it
         quadrature="gauss", points="nodal" if exact else "quadrature",
         basis="dual" if exact else "standard",

@@ -40,6 +40,7 @@ from rough_contact.references import effective_modulus
 from rough_contact.scenes.defaults import GRAIN_X, SEATING_STIFFNESS
 from rough_contact.scenes.defaults import quadrature_degree as default_qdeg
 from rough_contact.scenes.meshes.flat_punch import flat_punch
+from rough_contact.scenes.meshes.punch_section import punch_section
 from rough_contact.scenes.setup import check_mesh_arguments, check_points_basis
 from rough_contact.solver.loading import load_path, load_unload_factors
 from rough_contact.solver.snes import SNESSolver
@@ -47,7 +48,7 @@ from rough_contact.validation import check_integer, check_scalar
 
 __all__ = ["E", "NU", "TOTAL_FORCE", "MOMENTS_UM", "FRICTION_CASES", "HARDENING", "TABLE5",
            "PLASTIC", "NORMAL_LAWS", "effective_modulus", "make_law", "advise_law",
-           "write_advice", "PunchScene", "quarter_punch", "PunchModel",
+           "write_advice", "PunchScene", "quarter_punch", "punch_section_scene", "PunchModel",
            "build", "point_data", "plot_slip_directions", "PunchResult", "run"]
 
 # Silence the INFO lines of the JIT compiler (setuptools resets the root logger's level).
@@ -198,19 +199,37 @@ class PunchScene:
 
 def quarter_punch(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2,
                   load_half_width=2.5, cell_type="tetrahedron", *, edge_size=None,
-                  edge_band=None) -> PunchScene:
+                  edge_band=None, edge_growth=None) -> PunchScene:
     """Mesh the quarter punch and set its space and boundary conditions. Collective.
 
-    ``edge_size``, ``edge_band``: grading towards the punch's free edge
+    ``edge_size``, ``edge_band``, ``edge_growth``: grading towards the punch's free edge
     (:func:`rough_contact.scenes.meshes.flat_punch.flat_punch`; None: none)."""
     check_mesh_arguments(order, mesh_size=mesh_size, contact_size=contact_size,
                          load_half_width=load_half_width)
     scene = flat_punch(mesh_size=mesh_size, contact_size=contact_size, order=order,
                        load_half_width=load_half_width, cell_type=cell_type, comm=comm,
-                       edge_size=edge_size, edge_band=edge_band)
+                       edge_size=edge_size, edge_band=edge_band, edge_growth=edge_growth)
     V = vector_space(scene.mesh, order)
     ft = scene.facet_tags
     bcs = [fix(V, ft, scene.tag("symmetry_x"), 0), fix(V, ft, scene.tag("symmetry_y"), 1),
+           fix(V, ft, scene.tag("fixed"))]
+    return PunchScene(scene, V, bcs)
+
+
+def punch_section_scene(comm=MPI.COMM_WORLD, *, mesh_size=10.0, contact_size=0.7,
+                        edge_size=0.01, edge_growth=0.2, thickness=1.0) -> PunchScene:
+    """The plane-strain section of the punch's edge (Q1, one hexahedron thick; mesh of
+    :func:`rough_contact.scenes.meshes.punch_section.punch_section`) with its boundary
+    conditions: u_x = 0 on x = 0, u_y = 0 on both faces y = 0 and y = t (plane strain), the
+    foundation's base clamped. Collective.
+
+    :func:`build` takes it as ``punch_scene``; its ``total_force`` is then 4 x the section's
+    force (``build`` loads a quarter of it): ``4 * pressure * half_width * thickness``."""
+    scene = punch_section(mesh_size=mesh_size, contact_size=contact_size, edge_size=edge_size,
+                          edge_growth=edge_growth, thickness=thickness, comm=comm)
+    V = vector_space(scene.mesh, 1)
+    ft = scene.facet_tags
+    bcs = [fix(V, ft, scene.tag("symmetry_x"), 0), fix(V, ft, scene.tag("plane"), 1),
            fix(V, ft, scene.tag("fixed"))]
     return PunchScene(scene, V, bcs)
 
@@ -246,7 +265,7 @@ def build(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2, load_h
           cell_type="tetrahedron", *, punch_scene=None, total_force=TOTAL_FORCE,
           solver_defaults=None, quadrature="gauss", solver_options=None, enforcement=None,
           kt_over_kn=None, pairing="auto", points="quadrature", basis="standard",
-          edge_size=None, edge_band=None):
+          edge_size=None, edge_band=None, edge_growth=None):
     """Mesh, law, interface, problem and solver of the quarter punch. Collective.
 
     ``pairing`` pairs the punch bottom with the foundation (``ContactInterface(pairing=)``):
@@ -269,8 +288,8 @@ def build(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2, load_h
     basis: a vertex's jump uses its own DOFs, node to node on a conforming pairing;
     ``NodalContactInterface(basis=)``, docs/exact_contact_newton.md).
 
-    ``edge_size``, ``edge_band`` grade the mesh towards the punch's free edge (passed to
-    :func:`quarter_punch`; None: no edge grading).
+    ``edge_size``, ``edge_band``, ``edge_growth`` grade the mesh towards the punch's free
+    edge (passed to :func:`quarter_punch`; None: no edge grading).
 
     ``punch_scene`` reuses a :class:`PunchScene` of :func:`quarter_punch` (mesh sizes, order,
     cell type and edge grading are then taken from it); ``total_force`` is the full punch's
@@ -298,7 +317,8 @@ def build(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2, load_h
     check_points_basis(points, basis)
     if punch_scene is None:
         punch_scene = quarter_punch(comm, mesh_size, contact_size, order, load_half_width,
-                                    cell_type, edge_size=edge_size, edge_band=edge_band)
+                                    cell_type, edge_size=edge_size, edge_band=edge_band,
+                                    edge_growth=edge_growth)
     scene, V, bcs = punch_scene.scene, punch_scene.V, punch_scene.bcs
     order = element_degree(V)
 

@@ -45,6 +45,10 @@ def contact_face_facets(scene):
     (dict(edge_size=0.35, edge_band=10.5), r"edge_band = 10\.5 is invalid; valid range"),
     (dict(edge_size=0.35, edge_band=float("inf")), r"edge_band = inf is invalid"),
     (dict(edge_band=1.0), r"edge_band = 1\.0 is invalid without edge_size"),
+    (dict(edge_growth=0.3), r"edge_growth = 0\.3 is invalid without edge_size"),
+    (dict(edge_size=0.35, edge_growth=1.5), r"edge_growth = 1\.5 is invalid; valid range: "
+                                           r"\(0, 1\] mm per mm"),
+    (dict(edge_size=0.35, edge_growth=0.0), r"edge_growth = 0\.0 is invalid"),
     (dict(edge_size=0.35, cell_type="hexahedron"), r"edge_size = 0\.35 is invalid with "
                                                    r"cell_type = 'hexahedron'"),
 ])
@@ -119,3 +123,20 @@ def test_edge_grading_refines_the_edge(edge_size):
     assert inside.sum() > 0 and far.sum() > 0
     assert np.median(sides[inside]) < 1.5 * edge_size
     assert np.median(sides[far]) > 0.8 * 0.7
+
+
+def test_edge_growth_sets_the_size_beyond_the_band():
+    """With ``edge_growth`` g the size beyond the band is edge_size + g (d - band): at
+    d = 1.5-2.5 mm with edge_size = band = 0.35 and g = 0.1 about 0.47-0.57 mm, where the
+    default rate (0.93 per mm on level 1) has reached the contact size 0.7."""
+    sides_at = {}
+    for growth in (None, 0.1):
+        scene = flat_punch(mesh_size=10.0, contact_size=0.7, order=1, load_half_width=10.0,
+                           comm=COMM, edge_size=0.35, edge_band=0.35, edge_growth=growth)
+        assert scene.dimensions.get("edge_growth") == growth
+        facets = contact_face_facets(scene)
+        dist = np.minimum(A - facets[..., 0], A - facets[..., 1]).mean(axis=1)
+        sides = np.linalg.norm(facets - np.roll(facets, 1, axis=1), axis=2).max(axis=1)
+        sides_at[growth] = np.median(sides[(dist > 1.5) & (dist < 2.5)])
+    assert 0.45 < sides_at[0.1] < 0.62
+    assert sides_at[None] > 0.65

@@ -62,17 +62,21 @@ def _edge_distance(a):
 
 
 def edge_grading(contact_size: float, half_width: float, edge_size=None, edge_band=None,
-                 cell_type: str = "tetrahedron") -> tuple:
+                 cell_type: str = "tetrahedron", edge_growth=None) -> tuple:
     """The checked (edge_size, edge_band) of the grading towards the punch's free edge [mm]:
     (None, None) without ``edge_size``; the band defaults to ``contact_size``. Raises
     ValueError naming the quantity, its value and the valid range (0 < edge_size <=
-    contact_size, 0 < edge_band <= half_width, tetrahedra only). The benchmarks call it to
-    refuse a bad option before any mesh is built."""
+    contact_size, 0 < edge_band <= half_width, 0 < edge_growth <= 1 or None, tetrahedra
+    only). The benchmarks call it to refuse a bad option before any mesh is built."""
     if edge_size is None:
-        if edge_band is not None:
-            raise ValueError(f"edge_band = {edge_band!r} is invalid without edge_size; valid: "
-                             "None, or give edge_size too")
+        for name, value in (("edge_band", edge_band), ("edge_growth", edge_growth)):
+            if value is not None:
+                raise ValueError(f"{name} = {value!r} is invalid without edge_size; valid: "
+                                 "None, or give edge_size too")
         return None, None
+    if edge_growth is not None and not (np.isfinite(edge_growth) and 0 < edge_growth <= 1):
+        raise ValueError(f"edge_growth = {edge_growth!r} is invalid; valid range: (0, 1] mm "
+                         "per mm, or None")
     if cell_type != "tetrahedron":
         raise ValueError(f"edge_size = {edge_size!r} is invalid with cell_type = "
                          f"{cell_type!r}; edge grading is for tetrahedra only (edge_size "
@@ -87,13 +91,14 @@ def edge_grading(contact_size: float, half_width: float, edge_size=None, edge_ba
     return edge_size, edge_band
 
 
-def _edge_field(a, edge_size, edge_band, contact_size, mesh_size, transition):
+def _edge_field(a, edge_size, edge_band, contact_size, mesh_size, transition, growth=None):
     """``(distance, size, transition)`` of the edge grading for ``refine_towards(extra=)``:
-    ``edge_size`` within ``edge_band`` of the edge, then growing linearly at twice the patch
+    ``edge_size`` within ``edge_band`` of the edge, then growing linearly at ``growth`` mm per
+    mm (a geometric progression of ratio about 1 + growth), by default at twice the patch
     field's rate, (mesh_size - contact_size) / transition per mm, so that it falls below
     the patch field only near the edge (for mesh_size = contact_size, where that rate is 0,
     the size reaches contact_size at 2 edge_band). The distance is max(d - edge_band, 0)."""
-    rate = 2.0 * (mesh_size - contact_size) / transition
+    rate = 2.0 * (mesh_size - contact_size) / transition if growth is None else growth
     if rate <= 0.0:
         rate = (contact_size - edge_size) / edge_band if contact_size > edge_size else 1.0
     d = _edge_distance(a)
@@ -107,7 +112,8 @@ def flat_punch(mesh_size: float = 10.0, contact_size: typing.Optional[float] = N
                load_half_width: typing.Optional[float] = None,
                transition: typing.Optional[float] = None, cell_type: str = "tetrahedron",
                comm: MPI.Comm = MPI.COMM_WORLD, edge_size: typing.Optional[float] = None,
-               edge_band: typing.Optional[float] = None) -> Scene:
+               edge_band: typing.Optional[float] = None,
+               edge_growth: typing.Optional[float] = None) -> Scene:
     """Quarter model of the flat punch on the foundation (paper section 9.2). Collective.
 
     Args:
@@ -135,6 +141,10 @@ def flat_punch(mesh_size: float = 10.0, contact_size: typing.Optional[float] = N
             0 < edge_band <= half_width; beyond it the size grows linearly at twice the
             patch field's rate until the patch field is the smaller. Default
             ``contact_size``; only with ``edge_size``.
+        edge_growth: growth of the element size per mm beyond ``edge_band``, (0, 1]: the
+            elements then form a geometric progression of ratio about 1 + edge_growth away
+            from the edge. Default ``None``: twice the patch field's rate (see above); only
+            with ``edge_size``.
 
     Returns:
         The scene; ``contact_pair = (contact_punch, contact_foundation)``.
@@ -156,7 +166,8 @@ def flat_punch(mesh_size: float = 10.0, contact_size: typing.Optional[float] = N
     if load_half_width is not None and not 0 < load_half_width <= a:
         raise ValueError(f"load_half_width = {load_half_width} is invalid; valid range: "
                          f"(0, half_width = {a}] or None")
-    edge_size, edge_band = edge_grading(contact_size, a, edge_size, edge_band, cell_type)
+    edge_size, edge_band = edge_grading(contact_size, a, edge_size, edge_band, cell_type,
+                                        edge_growth)
     b = a if load_half_width is None else load_half_width
     tol = 1e-6 * max(L, H)
 
@@ -211,7 +222,8 @@ def flat_punch(mesh_size: float = 10.0, contact_size: typing.Optional[float] = N
             set_transfinite_hexahedra(model, contact_size, mesh_size, distance)
         else:
             extra = (() if edge_size is None else
-                     [_edge_field(a, edge_size, edge_band, contact_size, mesh_size, transition)])
+                     [_edge_field(a, edge_size, edge_band, contact_size, mesh_size, transition,
+                                  edge_growth)])
             _refinement_field(model, a, contact_size, mesh_size, transition, extra)
         generate(model, order)
 
@@ -221,4 +233,5 @@ def flat_punch(mesh_size: float = 10.0, contact_size: typing.Optional[float] = N
                         foundation_height=H, load_half_width=b, mesh_size=mesh_size,
                         contact_size=contact_size, transition=transition,
                         **({} if edge_size is None else
-                           dict(edge_size=edge_size, edge_band=edge_band))))
+                           dict(edge_size=edge_size, edge_band=edge_band)),
+                        **({} if edge_growth is None else dict(edge_growth=edge_growth))))
