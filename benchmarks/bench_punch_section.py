@@ -8,7 +8,8 @@ isotropic Coulomb friction, exact contact and stick: dual-basis nodal multiplier
 Newton), on meshes graded geometrically towards the edge down to ``--edge-size``
 (``rough_contact.scenes.meshes.punch_section``: one hexahedron thick, u_y = 0 on both faces).
 
-Per row: sizes, DOFs, contact vertices (per layer), Newton iterations, CPU, the dissipation per
+Per row: sizes, DOFs, interface points per layer (their x positions: the contact vertices for
+the exact route), Newton iterations, CPU, the dissipation per
 unit length of the edge at the peak and at the end [N mm / mm], the slip zone at the peak (the
 largest distance from the edge of a slipping vertex in contact, and how many slip), and the
 traction ratio |t_T| / p at the first vertices off the edge (for the stuck bonded edge it tends
@@ -64,8 +65,8 @@ def section_model(comm, mu, k, mesh_size, contact_size, edge_size, edge_growth, 
 
 
 def slip_zone(interface, comm, thickness):
-    """At the current state: (largest edge distance of a slipping vertex in contact [mm],
-    slipping vertices per layer, share of D on the edge vertex, the traction ratio
+    """At the current state: (largest edge distance of a slipping point in contact [mm],
+    distinct edge distances of the slipping points (vertices per layer for the nodal points), share of D on the edge vertex, the traction ratio
     |t_T| / p at the three nearest vertices off the edge (d, ratio) pairs)."""
     pf, x = interface.point_fields(), interface.point_coordinates()
     d = A - x[:, 0]
@@ -77,7 +78,7 @@ def slip_zone(interface, comm, thickness):
     near = np.unique(np.round(d[(d > 1e-12) & (p > 0)], 12))[:3]
     pairs = [(dd, float(np.mean(ratio[np.abs(d - dd) < 1e-12]))) for dd in near]
     total = Dw.sum()
-    return (float(d[slip].max(initial=0.0)), int(slip.sum()) // 2,   # two equal layers
+    return (float(d[slip].max(initial=0.0)), len(np.unique(np.round(d[slip], 12))),
             float(Dw[d < 1e-12].sum() / total) if total > 0 else float("nan"), pairs)
 
 
@@ -109,8 +110,8 @@ def run(mu, k, mesh_size, contact_size, edge_size, edge_growth, exact=True, al_t
     end_zone = slip_zone(m.interface, comm, thickness)
     cpu = comm.allreduce(time.process_time() - t0, op=MPI.SUM)
     peak = next(i for i in incs if i.load_factor == 1.0)
-    xyz = m.interface.point_coordinates()
-    verts = comm.allreduce(int(np.count_nonzero(xyz[:, 1] < 1e-9)), op=MPI.SUM)
+    d = np.concatenate(comm.allgather(A - m.interface.point_coordinates()[:, 0]))
+    verts = len(np.unique(np.round(d, 12)))     # points per layer (x positions)
     out = dict(mu=mu, k=k, exact=exact, mesh_size=mesh_size, contact_size=contact_size,
                edge_size=edge_size, edge_growth=edge_growth, dofs=m.problem.num_dofs,
                vertices=verts, newton=sum(i.newton_total for i in incs),

@@ -87,9 +87,14 @@ def punch_section(mesh_size: float = 10.0, contact_size: float = 0.7,
         raise ValueError(f"edge_growth = {edge_growth} is invalid; valid range: (0, 1]")
     tol = 1e-6 * max(L, H)
 
-    def build(model):
+    def make(model, algorithm, recombination):
+        """Geometry, groups, size field and mesh of one attempt; whether it is all
+        hexahedra (and quadrilaterals on every surface)."""
         import gmsh
 
+        # gmsh's default tolerance (relative to the model's size, 100 mm) merges the 1D mesh
+        # nodes of sub-micrometre edge elements and leaves triangles on the extruded sides
+        gmsh.option.setNumber("Geometry.Tolerance", 1e-14)
         geo = model.geo
         pts = {k: geo.addPoint(x, 0.0, z) for k, (x, z) in dict(
             A=(0, -H), B=(L, -H), C=(L, 0), D=(a, 0), O=(0, 0), E=(a, hp), F=(0, hp)).items()}
@@ -138,18 +143,36 @@ def punch_section(mesh_size: float = 10.0, contact_size: float = 0.7,
         field.setString(f, "F", size)
         field.setAsBackgroundMesh(f)
         for name, value in (("MeshSizeExtendFromBoundary", 0), ("MeshSizeFromPoints", 0),
-                            ("MeshSizeFromCurvature", 0), ("MeshSizeMax", mesh_size),
-                            ("Algorithm", 6), ("RecombinationAlgorithm", 3)):
+                            ("MeshSizeFromCurvature", 0), ("MeshSizeMax", mesh_size)):
             gmsh.option.setNumber(f"Mesh.{name}", value)
+        gmsh.option.setNumber("Mesh.Algorithm", algorithm)
+        gmsh.option.setNumber("Mesh.RecombinationAlgorithm", recombination)
         model.mesh.generate(3)
+        return (sorted(int(e) for e in model.mesh.getElementTypes(3)) == [5]
+                and all(list(model.mesh.getElementTypes(2, tag)) == [3]
+                        for _, tag in model.getEntities(2)))
+
+    def build(model):
+        import gmsh
+
+        # gmsh's quadrilateral recombination can leave a triangle (a prism once extruded),
+        # and a cleared extruded mesh keeps stale triangles: each attempt is a fresh model,
+        # with the 2D algorithm Frontal-Delaunay or Delaunay and Blossom full-quad or Blossom
+        # (gmsh 4.8's Frontal-Delaunay for quads, algorithm 8, crashed on this geometry)
+        attempts = ((6, 3), (5, 3), (6, 1), (5, 1), (1, 3))
+        for i, (algorithm, recombination) in enumerate(attempts):
+            if i:
+                gmsh.model.remove()
+                gmsh.model.add("punch_section")
+            if make(model, algorithm, recombination):
+                break
+        else:
+            raise RuntimeError("punch_section: gmsh left elements other than hexahedra "
+                               f"(triangles in the recombination) with every (2D algorithm, "
+                               f"recombination algorithm) tried: {attempts}")
         if order == 2:
             gmsh.option.setNumber("Mesh.SecondOrderIncomplete", 0)
             model.mesh.setOrder(2)
-        types = {int(e) for e in model.mesh.getElementTypes(3)}
-        if types != ({5} if order == 1 else {12}):
-            raise RuntimeError(f"punch_section: gmsh made volume element types {sorted(types)}, "
-                               "not hexahedra only (the quadrilateral recombination left "
-                               "triangles)")
 
     return build_contact_scene(
         comm, "punch_section", build, ("punch", "foundation"),
