@@ -27,6 +27,7 @@ from __future__ import annotations
 import argparse
 import sys
 import time
+import typing
 
 import petsc4py
 from _common import write_csv
@@ -64,22 +65,26 @@ def section_model(comm, mu, k, mesh_size, contact_size, edge_size, edge_growth, 
         solver_options=dict(linear_solver="mumps"))
 
 
-def slip_zone(interface, comm, thickness):
-    """At the current state: (largest edge distance of a slipping point in contact [mm],
-    distinct edge distances of the slipping points (vertices per layer for the nodal points), share of D on the edge vertex, the traction ratio
-    |t_T| / p at the three nearest vertices off the edge (d, ratio) pairs)."""
+class SlipZone(typing.NamedTuple):
+    """The slip zone at one state (every rank gets the same)."""
+
+    width: float         # largest edge distance of a slipping point in contact [mm]
+    positions: int       # distinct edge distances of the slipping points (per layer)
+    edge_share: float    # share of D on the points at the edge (nan without dissipation)
+    near: list           # (d, |t_T| / p) at the three points nearest to the edge, off it
+
+
+def slip_zone(interface, comm) -> SlipZone:
+    """The slip zone of the interface's current state (collective)."""
     pf, x = interface.point_fields(), interface.point_coordinates()
-    d = A - x[:, 0]
-    slip = pf.slipping & pf.contact
-    Dw = pf.dissipation * pf.weight
     ratio = np.linalg.norm(pf.shear, axis=1) / np.maximum(pf.pressure, 1e-300)
-    data = [np.concatenate(comm.allgather(v)) for v in (d, slip, Dw, ratio, pf.pressure)]
-    d, slip, Dw, ratio, p = data
+    d, slip, Dw, ratio, p = (np.concatenate(comm.allgather(v)) for v in (
+        A - x[:, 0], pf.slipping & pf.contact, pf.dissipation * pf.weight, ratio, pf.pressure))
     near = np.unique(np.round(d[(d > 1e-12) & (p > 0)], 12))[:3]
-    pairs = [(dd, float(np.mean(ratio[np.abs(d - dd) < 1e-12]))) for dd in near]
     total = Dw.sum()
-    return (float(d[slip].max(initial=0.0)), len(np.unique(np.round(d[slip], 12))),
-            float(Dw[d < 1e-12].sum() / total) if total > 0 else float("nan"), pairs)
+    return SlipZone(float(d[slip].max(initial=0.0)), len(np.unique(np.round(d[slip], 12))),
+                    float(Dw[d < 1e-12].sum() / total) if total > 0 else float("nan"),
+                    [(dd, float(np.mean(ratio[np.abs(d - dd) < 1e-12]))) for dd in near])
 
 
 def profile(interface, comm):
@@ -104,10 +109,10 @@ def run(mu, k, mesh_size, contact_size, edge_size, edge_growth, exact=True, al_t
     for inc in load_path(m.problem, m.solver, factors, verbose=verbose):
         incs.append(inc)
         if inc.load_factor == 1.0:
-            peak_zone = slip_zone(m.interface, comm, thickness)
+            peak_zone = slip_zone(m.interface, comm)
             if want_profile:
                 prof = profile(m.interface, comm)
-    end_zone = slip_zone(m.interface, comm, thickness)
+    end_zone = slip_zone(m.interface, comm)
     cpu = comm.allreduce(time.process_time() - t0, op=MPI.SUM)
     peak = next(i for i in incs if i.load_factor == 1.0)
     d = np.concatenate(comm.allgather(A - m.interface.point_coordinates()[:, 0]))
@@ -118,9 +123,9 @@ def run(mu, k, mesh_size, contact_size, edge_size, edge_growth, exact=True, al_t
                cutbacks=sum(i.cutbacks for i in incs), cpu=cpu,
                wall=time.perf_counter() - t_wall,
                D_peak=peak.dissipation / thickness, D_end=incs[-1].dissipation / thickness,
-               zone_peak=peak_zone[0], slipping_peak=peak_zone[1], edge_share_peak=peak_zone[2],
-               zone_end=end_zone[0], slipping_end=end_zone[1],
-               ratio_near=peak_zone[3])
+               zone_peak=peak_zone.width, slipping_peak=peak_zone.positions,
+               edge_share_peak=peak_zone.edge_share, zone_end=end_zone.width,
+               slipping_end=end_zone.positions, ratio_near=peak_zone.near)
     m.solver.destroy()
     return out, prof
 
