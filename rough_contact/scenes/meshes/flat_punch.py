@@ -45,6 +45,17 @@ from rough_contact.fem.mesh import (Scene, add_groups, build_contact_scene, enti
 __all__ = ["flat_punch"]
 
 
+def check_punch_sizes(half_width, foundation_half_width, mesh_size, contact_size) -> None:
+    """Raise ValueError unless the foundation is wider than the punch and the contact size
+    is at most the mesh size (both punch meshes)."""
+    if not foundation_half_width > half_width:
+        raise ValueError(f"foundation_half_width = {foundation_half_width} is invalid; valid "
+                         f"range: > half_width = {half_width}")
+    if contact_size > mesh_size:
+        raise ValueError(f"contact_size = {contact_size} is invalid; valid range: "
+                         f"(0, mesh_size = {mesh_size}]")
+
+
 def _refinement_field(model, a, contact_size, mesh_size, transition, extra=()):
     """Threshold on the exact distance to the patch [0, a]^2 x {0}: contact_size -> mesh_size
     (``extra``: further thresholds of ``refine_towards``, the smallest size winning)."""
@@ -157,12 +168,7 @@ def flat_punch(mesh_size: float = 10.0, contact_size: typing.Optional[float] = N
                       transition=transition)
     validate_order(order)
     validate_cell_type(cell_type)
-    if not L > a:
-        raise ValueError(f"foundation_half_width = {L} is invalid; valid range: > half_width "
-                         f"= {a}")
-    if contact_size > mesh_size:
-        raise ValueError(f"contact_size = {contact_size} is invalid; valid range: "
-                         f"(0, mesh_size = {mesh_size}]")
+    check_punch_sizes(a, L, mesh_size, contact_size)
     if load_half_width is not None and not 0 < load_half_width <= a:
         raise ValueError(f"load_half_width = {load_half_width} is invalid; valid range: "
                          f"(0, half_width = {a}] or None")

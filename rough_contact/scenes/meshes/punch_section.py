@@ -37,6 +37,7 @@ from mpi4py import MPI
 
 from rough_contact.fem.mesh import (Scene, add_groups, build_contact_scene, validate_order,
                                     validate_positive)
+from rough_contact.scenes.meshes.flat_punch import check_punch_sizes
 
 __all__ = ["punch_section"]
 
@@ -74,12 +75,7 @@ def punch_section(mesh_size: float = 10.0, contact_size: float = 0.7,
                       foundation_half_width=L, foundation_height=H, thickness=t,
                       transition=transition)
     validate_order(order)
-    if not L > a:
-        raise ValueError(f"foundation_half_width = {L} is invalid; valid range: > half_width "
-                         f"= {a}")
-    if contact_size > mesh_size:
-        raise ValueError(f"contact_size = {contact_size} is invalid; valid range: "
-                         f"(0, mesh_size = {mesh_size}]")
+    check_punch_sizes(a, L, mesh_size, contact_size)
     if edge_size > contact_size:
         raise ValueError(f"edge_size = {edge_size} is invalid; valid range: "
                          f"(0, contact_size = {contact_size}]")
