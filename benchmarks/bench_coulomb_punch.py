@@ -16,6 +16,7 @@ relative to the largest traction (about 1 for a penalty, the tolerance for exact
         [--al-tol 1e-3] [--basis standard dual] [--residual-ratio 1e-2] [--ssn-r R]
         [--continuation none 100,10] [--after 10] [--linear-solver auto mumps hypre] [--csv FILE]
         [--mesh-size H] [--contact-size HC] [--edge-size HE] [--edge-band B] [--edge-growth G]
+        [--order 1]
 
 Levels (P1; mesh and contact size in LEVELS): 1 ~4.5 k DOFs, 2 ~26 k, 3 ~73 k, 4 ~99 k (the size
 of GetFEM's finest run). ``--mesh-size`` (bulk element size, (0, 50] mm) and ``--contact-size``
@@ -91,7 +92,7 @@ def run(level: int, mu: float, k: float, width: float, predictor: str, quadratur
         comm=MPI.COMM_WORLD, verbose=False, reversal_stiffness=1.0, augmented=False,
         al_tol=1e-3, continuation=None, linear_solver="auto", residual_ratio=1e-2,
         basis="standard", mesh_size=None, contact_size=None, edge_size=None,
-        edge_band=None, ssn_r=None, edge_growth=None) -> dict:
+        edge_band=None, ssn_r=None, edge_growth=None, order=1) -> dict:
     mesh_size, contact_size = level_sizes(level, mesh_size, contact_size)
     edge_size, edge_band = edge_grading(contact_size, PUNCH_HALF_WIDTH, edge_size, edge_band,
                                         edge_growth=edge_growth)
@@ -105,7 +106,7 @@ def run(level: int, mu: float, k: float, width: float, predictor: str, quadratur
         enforcement = AugmentedLagrangian(tolerance=al_tol)
     else:
         enforcement = Penalty()
-    m = flat_punch.build(comm, mesh_size=mesh_size, contact_size=contact_size, order=1,
+    m = flat_punch.build(comm, mesh_size=mesh_size, contact_size=contact_size, order=order,
                          load_half_width=10.0, law=law, steps=N_LOAD,
                          quadrature="gauss" if quadrature == "nodal" else quadrature,
                          points="nodal" if quadrature == "nodal" else "quadrature",
@@ -153,7 +154,7 @@ def run(level: int, mu: float, k: float, width: float, predictor: str, quadratur
                failed=failed,
                edge_size=float("nan") if edge_size is None else edge_size,
                edge_band=float("nan") if edge_band is None else edge_band,
-               edge_growth=float("nan") if edge_growth is None else edge_growth)
+               edge_growth=float("nan") if edge_growth is None else edge_growth, order=order)
     m.solver.destroy()
     return out
 
@@ -228,6 +229,8 @@ def main(argv=None):
                     help="growth of the element size per mm beyond the edge band, (0, 1] "
                     "(a geometric grading of ratio about 1 + growth); default twice the patch "
                     "field's rate")
+    ap.add_argument("--order", type=int, default=1, choices=[1, 2],
+                    help="element order (P1 is GetFEM's; P2 for the bulk's own error)")
     ap.add_argument("--csv", default=None)
     ap.add_argument("--verbose", action="store_true")
     args, _petsc = ap.parse_known_args(argv)   # the rest goes to PETSc
@@ -270,7 +273,8 @@ def main(argv=None):
                             residual_ratio=args.residual_ratio, basis=basis,
                             mesh_size=args.mesh_size, contact_size=args.contact_size,
                             edge_size=args.edge_size, edge_band=args.edge_band,
-                            ssn_r=args.ssn_r, edge_growth=args.edge_growth)
+                            ssn_r=args.ssn_r, edge_growth=args.edge_growth,
+                            order=args.order)
                     rows.append(r)
                     label = pred + "/" + quad[0] + ("*" if basis == "dual" else "")
                     PETSc.Sys.Print(
