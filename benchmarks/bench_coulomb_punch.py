@@ -16,7 +16,7 @@ relative to the largest traction (about 1 for a penalty, the tolerance for exact
         [--al-tol 1e-3] [--basis standard dual] [--residual-ratio 1e-2] [--ssn-r R]
         [--continuation none 100,10] [--after 10] [--linear-solver auto mumps hypre] [--csv FILE]
         [--mesh-size H] [--contact-size HC] [--edge-size HE] [--edge-band B] [--edge-growth G]
-        [--order 1]
+        [--order 1] [--transition T]
 
 Levels (P1; mesh and contact size in LEVELS): 1 ~4.5 k DOFs, 2 ~26 k, 3 ~73 k, 4 ~99 k (the size
 of GetFEM's finest run). ``--mesh-size`` (bulk element size, (0, 50] mm) and ``--contact-size``
@@ -92,7 +92,7 @@ def run(level: int, mu: float, k: float, width: float, predictor: str, quadratur
         comm=MPI.COMM_WORLD, verbose=False, reversal_stiffness=1.0, augmented=False,
         al_tol=1e-3, continuation=None, linear_solver="auto", residual_ratio=1e-2,
         basis="standard", mesh_size=None, contact_size=None, edge_size=None,
-        edge_band=None, ssn_r=None, edge_growth=None, order=1) -> dict:
+        edge_band=None, ssn_r=None, edge_growth=None, order=1, transition=None) -> dict:
     mesh_size, contact_size = level_sizes(level, mesh_size, contact_size)
     edge_size, edge_band = edge_grading(contact_size, PUNCH_HALF_WIDTH, edge_size, edge_band,
                                         edge_growth=edge_growth)
@@ -111,7 +111,7 @@ def run(level: int, mu: float, k: float, width: float, predictor: str, quadratur
                          quadrature="gauss" if quadrature == "nodal" else quadrature,
                          points="nodal" if quadrature == "nodal" else "quadrature",
                          basis=basis, enforcement=enforcement, edge_size=edge_size,
-                         edge_band=edge_band, edge_growth=edge_growth,
+                         edge_band=edge_band, edge_growth=edge_growth, transition=transition,
                          solver_options=dict(continuation=continuation,
                                              linear_solver=linear_solver))
     factors = load_unload_factors(N_LOAD, N_LOAD - 1, final_factor=1.0 / N_LOAD)
@@ -154,7 +154,8 @@ def run(level: int, mu: float, k: float, width: float, predictor: str, quadratur
                failed=failed,
                edge_size=float("nan") if edge_size is None else edge_size,
                edge_band=float("nan") if edge_band is None else edge_band,
-               edge_growth=float("nan") if edge_growth is None else edge_growth, order=order)
+               edge_growth=float("nan") if edge_growth is None else edge_growth, order=order,
+               transition=float("nan") if transition is None else transition)
     m.solver.destroy()
     return out
 
@@ -229,6 +230,9 @@ def main(argv=None):
                     help="growth of the element size per mm beyond the edge band, (0, 1] "
                     "(a geometric grading of ratio about 1 + growth); default twice the patch "
                     "field's rate")
+    ap.add_argument("--transition", type=float, default=None,
+                    help="distance over which the element size grows from the contact size to "
+                    "the mesh size [mm], > 0; default 2 x the punch half width (20 mm)")
     ap.add_argument("--order", type=int, default=1, choices=[1, 2],
                     help="element order (P1 is GetFEM's; P2 for the bulk's own error)")
     ap.add_argument("--csv", default=None)
@@ -237,6 +241,9 @@ def main(argv=None):
     if args.mesh_size is not None and args.contact_size is not None and len(args.levels) > 1:
         ap.error(f"--mesh-size and --contact-size together replace both sizes of every level: "
                  f"give one level, not --levels {' '.join(map(str, args.levels))}")
+    if args.transition is not None and not (math.isfinite(args.transition)
+                                            and args.transition > 0):
+        ap.error(f"--transition = {args.transition} is invalid; valid range: > 0 mm")
     for level in args.levels:     # refused before any mesh is built
         try:
             edge_grading(level_sizes(level, args.mesh_size, args.contact_size)[1],
@@ -274,7 +281,7 @@ def main(argv=None):
                             mesh_size=args.mesh_size, contact_size=args.contact_size,
                             edge_size=args.edge_size, edge_band=args.edge_band,
                             ssn_r=args.ssn_r, edge_growth=args.edge_growth,
-                            order=args.order)
+                            order=args.order, transition=args.transition)
                     rows.append(r)
                     label = pred + "/" + quad[0] + ("*" if basis == "dual" else "")
                     PETSc.Sys.Print(

@@ -199,16 +199,18 @@ class PunchScene:
 
 def quarter_punch(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2,
                   load_half_width=2.5, cell_type="tetrahedron", *, edge_size=None,
-                  edge_band=None, edge_growth=None) -> PunchScene:
+                  edge_band=None, edge_growth=None, transition=None) -> PunchScene:
     """Mesh the quarter punch and set its space and boundary conditions. Collective.
 
-    ``edge_size``, ``edge_band``, ``edge_growth``: grading towards the punch's free edge
-    (:func:`rough_contact.scenes.meshes.flat_punch.flat_punch`; None: none)."""
+    ``edge_size``, ``edge_band``, ``edge_growth``: grading towards the punch's free edge;
+    ``transition``: the distance over which the size grows from the contact size to the mesh
+    size (:func:`rough_contact.scenes.meshes.flat_punch.flat_punch`; None: the defaults)."""
     check_mesh_arguments(order, mesh_size=mesh_size, contact_size=contact_size,
                          load_half_width=load_half_width)
     scene = flat_punch(mesh_size=mesh_size, contact_size=contact_size, order=order,
                        load_half_width=load_half_width, cell_type=cell_type, comm=comm,
-                       edge_size=edge_size, edge_band=edge_band, edge_growth=edge_growth)
+                       edge_size=edge_size, edge_band=edge_band, edge_growth=edge_growth,
+                       transition=transition)
     V = vector_space(scene.mesh, order)
     ft = scene.facet_tags
     bcs = [fix(V, ft, scene.tag("symmetry_x"), 0), fix(V, ft, scene.tag("symmetry_y"), 1),
@@ -265,7 +267,7 @@ def build(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2, load_h
           cell_type="tetrahedron", *, punch_scene=None, total_force=TOTAL_FORCE,
           solver_defaults=None, quadrature="gauss", solver_options=None, enforcement=None,
           kt_over_kn=None, pairing="auto", points="quadrature", basis="standard",
-          edge_size=None, edge_band=None, edge_growth=None):
+          edge_size=None, edge_band=None, edge_growth=None, transition=None):
     """Mesh, law, interface, problem and solver of the quarter punch. Collective.
 
     ``pairing`` pairs the punch bottom with the foundation (``ContactInterface(pairing=)``):
@@ -289,7 +291,8 @@ def build(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2, load_h
     ``NodalContactInterface(basis=)``, docs/exact_contact_newton.md).
 
     ``edge_size``, ``edge_band``, ``edge_growth`` grade the mesh towards the punch's free
-    edge (passed to :func:`quarter_punch`; None: no edge grading).
+    edge, ``transition`` sets the patch field's growth distance (passed to
+    :func:`quarter_punch`; None: no edge grading, the default distance 2 a).
 
     ``punch_scene`` reuses a :class:`PunchScene` of :func:`quarter_punch` (mesh sizes, order,
     cell type and edge grading are then taken from it); ``total_force`` is the full punch's
@@ -318,7 +321,7 @@ def build(comm=MPI.COMM_WORLD, mesh_size=20.0, contact_size=2.0, order=2, load_h
     if punch_scene is None:
         punch_scene = quarter_punch(comm, mesh_size, contact_size, order, load_half_width,
                                     cell_type, edge_size=edge_size, edge_band=edge_band,
-                                    edge_growth=edge_growth)
+                                    edge_growth=edge_growth, transition=transition)
     scene, V, bcs = punch_scene.scene, punch_scene.V, punch_scene.bcs
     order = element_degree(V)
 
