@@ -88,9 +88,11 @@ def slip_zone(interface, comm) -> SlipZone:
 
 
 def profile(interface, comm):
-    """(d, p, |t_T|, slipping) of every vertex of one layer at the current state, by d."""
+    """(d, p, |t_T|, slipping) of the points of one layer (the smallest y: the vertices at
+    y = 0, or the first row of Gauss points) at the current state, by d. Collective."""
     pf, x = interface.point_fields(), interface.point_coordinates()
-    keep = x[:, 1] < 1e-9
+    y0 = comm.allreduce(float(x[:, 1].min(initial=np.inf)), op=MPI.MIN)
+    keep = x[:, 1] < y0 + 1e-9
     cols = [A - x[keep, 0], pf.pressure[keep], np.linalg.norm(pf.shear[keep], axis=1),
             (pf.slipping & pf.contact)[keep].astype(float)]
     cols = [np.concatenate(comm.allgather(c)) for c in cols]
