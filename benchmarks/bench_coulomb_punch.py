@@ -92,7 +92,8 @@ def run(level: int, mu: float, k: float, width: float, predictor: str, quadratur
         comm=MPI.COMM_WORLD, verbose=False, reversal_stiffness=1.0, augmented=False,
         al_tol=1e-3, continuation=None, linear_solver="auto", residual_ratio=1e-2,
         basis="standard", mesh_size=None, contact_size=None, edge_size=None,
-        edge_band=None, ssn_r=None, edge_growth=None, order=1, transition=None) -> dict:
+        edge_band=None, ssn_r=None, edge_growth=None, order=1, transition=None,
+        want_slip_map=False) -> dict:
     mesh_size, contact_size = level_sizes(level, mesh_size, contact_size)
     edge_size, edge_band = edge_grading(contact_size, PUNCH_HALF_WIDTH, edge_size, edge_band,
                                         edge_growth=edge_growth)
@@ -117,6 +118,7 @@ def run(level: int, mu: float, k: float, width: float, predictor: str, quadratur
     factors = load_unload_factors(N_LOAD, N_LOAD - 1, final_factor=1.0 / N_LOAD)
     t0 = time.process_time()
     exact = (float("nan"), float("nan"))
+    smap = []
     incs = []
     kwargs = {"predictor": predictor}
     failed = ""
@@ -125,6 +127,8 @@ def run(level: int, mu: float, k: float, width: float, predictor: str, quadratur
             incs.append(inc)
             if inc.load_factor == 1.0:
                 exact = _exactness(m.interface, law, comm)
+                if want_slip_map:
+                    smap = slip_map(m.interface, comm)
     except LoadStepError as exc:     # reported as a row: the run did not complete
         failed = f"LoadStepError at load factor {exc.load_factor:.6g}"
         PETSc.Sys.Print(f"  FAILED: {exc}")
@@ -155,9 +159,36 @@ def run(level: int, mu: float, k: float, width: float, predictor: str, quadratur
                edge_size=float("nan") if edge_size is None else edge_size,
                edge_band=float("nan") if edge_band is None else edge_band,
                edge_growth=float("nan") if edge_growth is None else edge_growth, order=order,
-               transition=float("nan") if transition is None else transition)
+               transition=float("nan") if transition is None else transition,
+               slip_map=smap)
     m.solver.destroy()
     return out
+
+
+SLIP_MAP_BINS = (0.0, 5.0, 8.0, 9.0, 9.5, 9.9, 9.99, PUNCH_HALF_WIDTH)
+
+
+def slip_map(interface, comm, bins=SLIP_MAP_BINS) -> list:
+    """Where along the punch's free edges the dissipation lies, at the current state
+    (collective). Each interface point is assigned to its nearer free edge (x = a or y = a of
+    the quarter): d = a - max(x, y) is its distance to that edge and s = min(x, y) its
+    position along it (s = a is the corner). Per bin [s0, s1) of ``bins``: (s0, s1, share of
+    the accumulated dissipation, number of slipping points, the largest d of a slipping point
+    [mm]); the last bin includes s = a."""
+    pf, x = interface.point_fields(), interface.point_coordinates()
+    d, s, slip, Dw = (np.concatenate(comm.allgather(v)) for v in (
+        PUNCH_HALF_WIDTH - np.maximum(x[:, 0], x[:, 1]), np.minimum(x[:, 0], x[:, 1]),
+        pf.slipping & pf.contact, pf.dissipation * pf.weight))
+    total = Dw.sum()
+    which = np.clip(np.searchsorted(bins, s, side="right") - 1, 0, len(bins) - 2)
+    rows = []
+    for b in range(len(bins) - 1):
+        inb = which == b
+        rows.append((bins[b], bins[b + 1],
+                     float(Dw[inb].sum() / total) if total > 0 else float("nan"),
+                     int(np.count_nonzero(slip & inb)),
+                     float(d[slip & inb].max(initial=0.0))))
+    return rows
 
 
 def _exactness(interface, law, comm) -> tuple:
@@ -235,6 +266,9 @@ def main(argv=None):
                     "the mesh size [mm], > 0; default 2 x the punch half width (20 mm)")
     ap.add_argument("--order", type=int, default=1, choices=[1, 2],
                     help="element order (P1 is GetFEM's; P2 for the bulk's own error)")
+    ap.add_argument("--slip-map", action="store_true",
+                    help="print, after each row, where along the free edges the dissipation "
+                    "and the slip zone lie at the peak (slip_map)")
     ap.add_argument("--csv", default=None)
     ap.add_argument("--verbose", action="store_true")
     args, _petsc = ap.parse_known_args(argv)   # the rest goes to PETSc
@@ -281,7 +315,8 @@ def main(argv=None):
                             mesh_size=args.mesh_size, contact_size=args.contact_size,
                             edge_size=args.edge_size, edge_band=args.edge_band,
                             ssn_r=args.ssn_r, edge_growth=args.edge_growth,
-                            order=args.order, transition=args.transition)
+                            order=args.order, transition=args.transition,
+                            want_slip_map=args.slip_map)
                     rows.append(r)
                     label = pred + "/" + quad[0] + ("*" if basis == "dual" else "")
                     PETSc.Sys.Print(
@@ -299,8 +334,14 @@ def main(argv=None):
                         f"{r['D_end']:10.4e} {r['slip_peak']:5.2f} {r['gap_peak']:8.1e} "
                         f"{r['stick_peak']:8.1e}"
                         + (f"  FAILED ({r['failed']})" if r["failed"] else ""))
+                    if r["slip_map"]:
+                        PETSc.Sys.Print("      s along the edge [mm]   D share   slipping   "
+                                        "slip zone width [mm]")
+                        for s0, s1, share, n, w in r["slip_map"]:
+                            PETSc.Sys.Print(f"      [{s0:5.2f}, {s1:5.2f})   {share:9.4f} "
+                                            f"{n:9d}   {w:11.4g}")
     if args.csv and MPI.COMM_WORLD.rank == 0:
-        write_csv(args.csv, rows)
+        write_csv(args.csv, [{k: v for k, v in r.items() if k != "slip_map"} for r in rows])
     return rows
 
 
