@@ -16,7 +16,7 @@ relative to the largest traction (about 1 for a penalty, the tolerance for exact
         [--al-tol 1e-3] [--basis standard dual] [--residual-ratio 1e-2] [--ssn-r R]
         [--continuation none 100,10] [--after 10] [--linear-solver auto mumps hypre] [--csv FILE]
         [--mesh-size H] [--contact-size HC] [--edge-size HE] [--edge-band B] [--edge-growth G]
-        [--order 1] [--transition T]
+        [--order 1] [--transition T] [--slip-map]
 
 Levels (P1; mesh and contact size in LEVELS): 1 ~4.5 k DOFs, 2 ~26 k, 3 ~73 k, 4 ~99 k (the size
 of GetFEM's finest run). ``--mesh-size`` (bulk element size, (0, 50] mm) and ``--contact-size``
